@@ -442,6 +442,34 @@ def test_a_folder_of_12_bit_pngs_tracks_as_its_8_bit_frames_with_one_warning(
     assert len(read_mot(outs[0])) > 0
 
 
+def test_a_broken_image_in_a_folder_is_one_warning_and_every_frame_tracked(
+    scene: Scene, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Trial61: one broken image at frame 298 of 300 ended ``pftrack track`` with an error,
+    every frame tracked before it lost. The frame before stands in now, said on one line; a
+    folder none of whose images can be read is one error line and exit 2."""
+    folder = scene.write_images(tmp_path / "imgs")
+    bad = folder / f"{len(scene.frames) - 2:06d}.png"
+    bad.write_bytes(bad.read_bytes()[:200])  # a copy cut short
+    out = tmp_path / "t.txt"
+    assert main(["track", str(folder), "--out", str(out), "--quiet"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith(
+        f"pftrack track: warning: frame {len(scene.frames) - 2}: cannot read image {bad}: "
+    ), err
+    assert err[0].endswith(
+        "the frame before stands in for it, so the later frames keep their numbers"
+    )
+    assert read_mot(out)[:, 0].max() > len(scene.frames) - 2  # tracked past it
+    for image in folder.iterdir():
+        image.write_bytes(b"")
+    assert main(["track", str(folder), "--out", str(out), "--quiet"]) == 2
+    assert capsys.readouterr().err == (
+        f"pftrack track: error: cannot read any of the {len(scene.frames)} images in folder "
+        f"{folder}: 000001.png: it is empty (0 bytes)\n"
+    )
+
+
 def test_a_folder_of_sequences_given_to_track_names_them_and_batch(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

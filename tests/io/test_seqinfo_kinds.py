@@ -7,8 +7,10 @@
   undecodable byte was replaced, so the image folder was ``caf\\ufffd``, which "does not
   exist" beside ``café`` (exit 2). It is now read in that encoding and the folder found.
 * A ``seqinfo.ini`` saying 1.25 times its frames' size (frames 640x480, ``imWidth=800``) beside
-  a det.txt in the frames' pixels scales the boxes by 0.8 with only a note: not fixed here (the
-  check is tracking.run's, another helper's file); a strict xfail (docs/robustness.md).
+  a det.txt in the frames' pixels scaled the boxes by 0.8 with only a note, exit 0: refused now
+  (tracking.run's ``_at_edges``: the boxes as given reach the frames' right and bottom edges),
+  and the rule leaves every real sequence's det.txt in its seqinfo.ini's pixels scaled onto
+  frames of 0.5 to 0.99 times that size (docs/robustness.md).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import pytest
 
 from pftrack.cli import main
 from pftrack.io.video import find_sequence, read_seqinfo
+from pftrack.tracking.run import EDGE_MAX_SCALE, _check_layout, _Scaled, load_detections
 from tests.conftest import dataset
 
 INI = (
@@ -67,16 +70,11 @@ def test_a_non_ascii_im_dir_is_read_in_the_file_s_encoding(tmp_path: Path, encod
     assert main(["-q", "track", str(seq), "--out", str(tmp_path / "t.txt")]) == 0
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="seqinfo.ini 1.25x its frames beside a det.txt in the frames' pixels is scaled by "
-    "0.8 with a note only; the rule (det.txt boxes as given reach the frames' right and bottom "
-    "edges, as every det.txt here reaches >= 98% of imWidth and imHeight) belongs in "
-    "tracking.run's _refuse_scaled_off (docs/robustness.md)",
-)
 def test_a_seqinfo_larger_than_its_frames_beside_their_detections_is_refused(
-    tmp_path: Path,
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    """Was a strict xfail (left61): scaled by 0.8 with a note only, exit 0 (5 tracks, 118
+    boxes). Refused now, naming both sizes; --det-scale 1 takes the boxes as given."""
     tud = dataset("tud-campus")
     seq = tmp_path / "tud125"
     seq.mkdir()
@@ -89,3 +87,42 @@ def test_a_seqinfo_larger_than_its_frames_beside_their_detections_is_refused(
     argv = ["-q", "track", str(seq), "--detections", str(seq / "det.txt"),
             "--out", str(tmp_path / "t.txt")]  # fmt: skip
     assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and not (tmp_path / "t.txt").exists(), err
+    n = len(np.loadtxt(seq / "det.txt", delimiter=","))
+    assert err == (
+        f"pftrack track: error: all {n} detection boxes, scaled by 0.8 (the frames' width 640 "
+        f"over imWidth=800 in {seq / 'seqinfo.ini'}), stop at 511x378, short of the 640x480 "
+        "frames' right and bottom edges by the scale, and as given they reach those edges "
+        "(they reach 639x472): they are in the frames' pixels already: seqinfo.ini's 800x600 "
+        "is not its images' size? correct it to 640x480 (gt.txt is scaled by it too), or give "
+        "--det-scale 1 / load_detections(scale=1)\n"
+    )
+    assert main([*argv, "--det-scale", "1"]) == 0
+    assert main([*argv, "--det-scale", "0.7"]) == 0  # another scale than seqinfo's: the user's
+
+
+@pytest.mark.parametrize(
+    "name",
+    ["pets09-s2l1", "tud-campus", "mot15-gt/ADL-Rundle-6", "mot15-gt/ETH-Sunnyday",
+     "mot15-gt/KITTI-17"],
+)  # fmt: skip
+def test_the_edge_rule_on_every_real_det_txt(name: str) -> None:
+    """Each real det.txt (in its seqinfo.ini's pixels) on frames 0.5-0.99 times that size, as a
+    downscaled video has them: taken with the scale, never refused. The same boxes rewritten in
+    the frames' pixels, seqinfo.ini kept (the case refused above): refused up to a scale of
+    0.95 (EDGE_MAX_SCALE; above it the scale moves boxes by under 5 % and is taken)."""
+    folder = dataset(name)
+    info = read_seqinfo(folder)
+    assert info.width is not None and info.height is not None
+    for s in (0.5, 0.625, 0.75, 0.8, 0.9, 0.94, 0.96, 0.99):
+        cols, rows = round(info.width * s), round(info.height * s)
+        applied = cols / info.width
+        own = load_detections(folder / "det.txt", applied)
+        _check_layout(own, (rows, cols, 3), info)  # not refused
+        in_frames = _Scaled(dict(load_detections(folder / "det.txt", applied**2)), applied)
+        if applied <= EDGE_MAX_SCALE:
+            with pytest.raises(ValueError, match="they are in the frames' pixels already"):
+                _check_layout(in_frames, (rows, cols, 3), info)
+        else:
+            _check_layout(in_frames, (rows, cols, 3), info)

@@ -49,7 +49,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pftrack._check import brief, number, path_arg, real, shown
-from pftrack._text import counted
+from pftrack._text import counted, listed
 from pftrack._threads import wait_through_interrupts
 from pftrack._typing import PathLike, RealLike
 from pftrack._warn import warn_outside
@@ -1410,7 +1410,19 @@ def _odd_depth(path: Path) -> str | None:
     return f"{image.dtype.itemsize * 8}-bit {kind.get(image.dtype.kind, 'values')} ({image.dtype})"
 
 
-def _unreadable(path: Path, notes: Sequence[str]) -> str:
+class _Unreadable(ValueError):
+    """An image of a folder that cannot be read (:func:`_unreadable`): `path` and `why`.
+
+    Its reader stands the frame before in for it (:meth:`FrameSource._iter_stored`); raised out
+    of a reader only when no image of the folder can be read, or by :func:`_open_depth`'s caller.
+    """
+
+    def __init__(self, path: Path, why: str) -> None:
+        super().__init__(f"cannot read image {path}: {why}")
+        self.path, self.why = path, why
+
+
+def _unreadable(path: Path, notes: Sequence[str]) -> _Unreadable:
     """The error of image `path` of a folder that cannot be read, saying why.
 
     An empty file (a copy that failed), a folder or a broken link named like an image, a file
@@ -1441,7 +1453,7 @@ def _unreadable(path: Path, notes: Sequence[str]) -> str:
                 path.open("rb").close()
             except OSError as exc:
                 why = exc.strerror or str(exc)
-    return f"cannot read image {path}: {why}"
+    return _Unreadable(path, why)
 
 
 def image_files(folder: Path) -> list[Path]:
@@ -1702,11 +1714,12 @@ class FrameSource:
         If `source` is not a path, a string or an int (a bool is refused).
     ValueError
         If it is empty or a negative camera index; if it cannot be opened or decoded, or holds
-        no frame; if two images of a folder have one number, or another size than the first,
-        or are 16-bit where the first is 8-bit (when read); or if a MOTChallenge sequence's
-        image folder is named by number and one is missing (a hole in the numbering, numbers
-        that do not start at 1 or a count other than ``seqLength``); if read (iterated,
-        :meth:`frames_at`) after :meth:`stop`.
+        no frame (an image folder none of whose images can be read: the count and the first's
+        reason); if two images of a folder have one number, or another size than the first
+        that can be read, or are 16-bit where it is 8-bit (when read); or if a MOTChallenge
+        sequence's image folder is named by number and one is missing (a hole in the
+        numbering, numbers that do not start at 1 or a count other than ``seqLength``); if
+        read (iterated, :meth:`frames_at`) after :meth:`stop`.
 
     Warns
     -----
@@ -1724,7 +1737,10 @@ class FrameSource:
         when a video with a rate from the file has clearly uneven time stamps
         (:func:`_uneven_steps`), a variable frame rate read as one: as soon as its first
         :data:`UNEVEN_FIRST_CHECK` frames show it (then 100, 200, ...), else once it was read to
-        its end.
+        its end. Once, when an image of a folder cannot be read (empty, cut short, not an
+        image: the frame before stands in, a black frame for those before the first that can
+        be read, counted by :attr:`lead_black`): as it is read, naming it and why; at the end of
+        a pass again only if more could not be, with their count and first names.
 
     Notes
     -----
@@ -1770,8 +1786,14 @@ class FrameSource:
         self._warned_lead = False  # its first frames could not be decoded (_warn_lead)
         self._warned_cut = False  # its first frames were left out by FFmpeg (_warn_cut_start)
         #: how many of its first frames did not decode and are black stand-ins (0: none, or
-        #: not read yet); known once its first frame is read
+        #: not read yet); known once its first frame is read (an image folder's: when opened,
+        #: the images before the first that can be read)
         self.lead_black = 0
+        # an image folder's images that cannot be read, by index (the frame before stands in:
+        # _image_frame), and those said (_warn_unread): once, at the end of a pass only more
+        self._bad: dict[int, _Unreadable] = {}
+        self._said_bad: frozenset[int] = frozenset()
+        self._folder: Path | None = None  # the folder of an image folder's images
         self._broken: tuple[int, int] | None = None  # an AVI's chunks break off (_avi_break)
         self._cap: Any = None
         self._reading = False  # a thread is inside the live capture's read()
@@ -1892,9 +1914,22 @@ class FrameSource:
         numbered = _frame_order(folder, images, seq if own else None)
         self._images = numbered or _natural_order(folder, images)
         self.gap = _gap(folder, self._images)
-        first = self._open_depth(folder, self._images[0])
-        self._image_shape = (int(first.shape[0]), int(first.shape[1]))
-        return first, len(self._images)
+        self._folder = folder
+        for k, path in enumerate(self._images):
+            try:
+                first = self._open_depth(folder, path)
+            except _Unreadable as unread:  # a black frame stands in for it (_iter_stored)
+                self._bad[k] = unread
+                continue
+            self._image_shape = (int(first.shape[0]), int(first.shape[1]))
+            self.lead_black = k
+            return first, len(self._images)
+        if len(self._images) == 1:
+            raise self._bad[0]
+        raise ValueError(
+            f"cannot read any of the {len(self._images)} images in folder {folder}: "
+            f"{self._bad[0].path.name}: {self._bad[0].why}"
+        )
 
     def _open_depth(self, folder: Path, path: Path) -> NDArray[Any]:
         """A folder's first image, 8-bit; sets :attr:`bits` when it is 16-bit of fewer bits.
@@ -1909,7 +1944,7 @@ class FrameSource:
         unsaid: list[str] = []  # the decoders' notes: said when the images are read as frames
         first = read_image_depth(path, notes=unsaid)
         if first is None:
-            raise ValueError(_unreadable(path, unsaid))
+            raise _unreadable(path, unsaid)
         if first.dtype == np.uint8:  # the pixels read_image gives
             self._eight_bit = True
             return first
@@ -1927,7 +1962,7 @@ class FrameSource:
         if bits == 16:  # full range, or another depth: as OpenCV reads it (a float TIFF: refused)
             again = read_image(path, notes=unsaid)
             if again is None:
-                raise ValueError(_unreadable(path, unsaid))
+                raise _unreadable(path, unsaid)
             return again
         self.bits = bits
         self._depth_from = (
@@ -2047,7 +2082,7 @@ class FrameSource:
         if self._eight_bit and path.suffix.lower() in DEEP_SUFFIXES:
             img = read_image_depth(path, notes=notes)  # an 8-bit image: read_image's pixels
             if img is not None and img.dtype == np.uint16:
-                first = self._images[0].name if self._images else "the first image"
+                first = self._images[self.lead_black].name if self._images else "the first image"
                 raise ValueError(
                     f"image {path} is 16-bit but {first}, the folder's first, is 8-bit: a "
                     "folder's images must have one depth (its 16-bit images are read at the "
@@ -2064,7 +2099,7 @@ class FrameSource:
             elif img is not None and img.dtype != np.uint8:
                 img = read_image(path, notes=notes)
         if img is None:
-            raise ValueError(_unreadable(path, notes))
+            raise _unreadable(path, notes)
         if not self._cut_said and path.suffix.lower() in (".jpg", ".jpeg") and _cut_jpeg(path):
             self._cut_said = True
             warn_outside(
@@ -2083,7 +2118,7 @@ class FrameSource:
             )
         if img.shape[:2] != self._image_shape:
             h0, w0 = self._image_shape
-            first = self._images[0].name if self._images else "the first image"
+            first = self._images[self.lead_black].name if self._images else "the first image"
             raise ValueError(
                 f"image {path} is {img.shape[1]}x{img.shape[0]} but {first} is {w0}x{h0}: "
                 "every image of a folder must have one size"
@@ -2204,9 +2239,10 @@ class FrameSource:
             return []
         keep = prepare if prepare is not None else _as_read
         if self._images is not None:
-            out = []
+            out, lost = [], list[int]()
             for i in (i for i in wanted if i < len(self._images)):
-                out.append(keep(self._read_image(self._images[i])))
+                out.append(keep(self._image_frame(i, lost)))
+            self._warn_unread(lost, at_end=True)
             return out
         try:
             return self._file_frames_at(wanted, split, keep)
@@ -2403,10 +2439,18 @@ class FrameSource:
                 "a new FrameSource reads it again"
             )
 
+    def _iter_images(self, images: list[Path]) -> Generator[NDArray[np.uint8], None, None]:
+        """An image folder's frames: an image that cannot be read stands in by the frame before."""
+        lost: list[int] = []
+        last: NDArray[np.uint8] | None = None
+        for i in range(len(images)):
+            last = self._image_frame(i, lost, last)
+            yield last
+        self._warn_unread(lost, at_end=True)
+
     def _iter_stored(self) -> Generator[NDArray[np.uint8], None, None]:
         if self._images is not None:
-            for p in self._images:
-                yield self._read_image(p)
+            yield from self._iter_images(self._images)
             return
         cap = _file_capture(str(self.path))
         decoded = 0  # frames yielded, stand-ins included: the next frame's index
@@ -2485,6 +2529,72 @@ class FrameSource:
         warn_outside(
             f"{self.path}: {_frame_list(lost)} could not be decoded (a damaged file?): the "
             f"frame before stands in for each{kept}",
+            UserWarning,
+        )
+
+    def _image_frame(
+        self, i: int, lost: list[int], before: NDArray[np.uint8] | None = None
+    ) -> NDArray[np.uint8]:
+        """Image `i` of the folder as a frame; if it cannot be read, the frame that stands in.
+
+        The frame before (`before`, when the caller holds it; else the nearest image before
+        `i` that can be read), or a black frame when none before it can be (the folder's first
+        images: :attr:`lead_black`), as a video's frames that fail to decode (was: the run
+        ended with an error, every frame tracked before it lost; a user trial). `i` is added
+        to `lost` and said (:meth:`_warn_unread`) before its stand-in is given.
+        """
+        frame = self._try_image(i)
+        if frame is not None:
+            return frame
+        lost.append(i)
+        self._warn_unread(lost, at_end=False)
+        if before is not None:
+            return before
+        for j in range(i - 1, -1, -1):
+            frame = self._try_image(j)
+            if frame is not None:
+                return frame
+        return np.zeros((self.height, self.width, 3), np.uint8)
+
+    def _try_image(self, i: int) -> NDArray[np.uint8] | None:
+        """Image `i` of the folder, read (:meth:`_read_image`); None if it cannot be (kept)."""
+        assert self._images is not None
+        if i in self._bad:  # not read again: a pass's stand-ins are those of every other pass
+            return None
+        try:
+            return self._read_image(self._images[i])
+        except _Unreadable as error:
+            self._bad[i] = error
+            return None
+
+    def _warn_unread(self, lost: list[int], *, at_end: bool) -> None:
+        """Warn that the images at `lost` (0-based) could not be read (stand-ins given).
+
+        As :meth:`_warn_lost` says a video's frames: the first as it is met, naming its file
+        and why; at the end of a pass, the pass's count and first names, only if more than
+        those said already. The same thing is never said twice.
+        """
+        if not lost or (not at_end and self._said_bad) or set(lost) <= self._said_bad:
+            return
+        self._said_bad |= frozenset(lost)
+        black = sum(i < self.lead_black for i in lost)
+        if not at_end:
+            error = self._bad[lost[0]]
+            stand = (
+                "a black frame (no image before it can be read)" if black else "the frame before"
+            )
+            warn_outside(
+                f"frame {lost[0] + 1}: {error}; {stand} stands in for it, so the later frames "
+                "keep their numbers",
+                UserWarning,
+            )
+            return
+        assert self._images is not None
+        names = listed([self._images[i].name for i in lost])
+        first = f" (a black frame for {_frame_list(lost[:black])}: no image before it can be read)"
+        warn_outside(
+            f"{self._folder}: {counted(len(lost), 'image')} could not be read ({names}; "
+            f"{_frame_list(lost)}): the frame before stands in for each{first * (black > 0)}",
             UserWarning,
         )
 
@@ -2686,7 +2796,7 @@ class FrameSequence(Sequence[NDArray[np.uint8]]):
             return self._last[1]
         self.source._refuse_stopped()  # was: "the video ended after 0 frames"
         if self.source._images is not None:
-            frame = self.source._read_image(self.source._images[i])
+            frame = self.source._image_frame(i, [])
         elif self._stored is None:
             if self._cap is None or i < self._at:  # a new pass from the start
                 self.close()

@@ -609,6 +609,16 @@ OUTSIDE_SHARE = 0.1
 #: How far past ``seqinfo.ini``'s image size (a share of it) boxes may reach and still be taken
 #: for boxes in its pixels (detectors' boxes overhang the edge a little).
 SEQINFO_SLACK = 0.1
+#: How near the frames' right and bottom edges (a share of each) boxes as given must reach to be
+#: taken for boxes in the frames' pixels when ``seqinfo.ini`` is larger than the frames: every
+#: det.txt here reaches at least 98.3 % of its own image size on each axis (PETS09 767x575 of
+#: 768x576, TUD-Campus 639x472 of 640x480, ADL-Rundle-6, ETH-Sunnyday, KITTI-17 99.7 % or more).
+EDGE_REACH = 0.98
+#: The largest scale (frames' width over ``imWidth``) :data:`EDGE_REACH` is applied at: closer to
+#: 1, boxes in ``seqinfo.ini``'s pixels reach the frames' edges too (at 0.98, TUD-Campus's bottom
+#: 472 of 470 rows), and the scale moves boxes by under 5 %. Up to it no det.txt here (>= 98.3 %
+#: of its size) can be taken for one in the frames' pixels: that needs under (1 + 0.95) / 2.
+EDGE_MAX_SCALE = 0.95
 #: Round ratios of image sizes the hint names in place of an estimate just above them (the
 #: boxes seldom reach the image's last pixel: PETS09's reach 767 of 768, 0.626 for 0.625).
 ROUND_RATIOS = (0.5, 0.25, 0.625, 0.75, 0.8, 1 / 3, 2 / 3)
@@ -646,6 +656,22 @@ def _scale_hint(
     return f"about {max(near):.4g} here" if near else f"about {estimate:.3g} here"
 
 
+def _at_edges(right: float, bottom: float, cols: int, rows: int, scale: float) -> bool:
+    """Whether boxes reaching `right` x `bottom` as given are in `cols` x `rows` frames' pixels.
+
+    For a ``seqinfo.ini`` larger than its frames (`scale` < 1, the frames' width over
+    ``imWidth``): boxes in its pixels reach about ``cols / scale`` (every det.txt reaches at
+    least :data:`EDGE_REACH` of its own image size on each axis), boxes in the frames' pixels
+    about `cols`. Theirs when both reach at least :data:`EDGE_REACH` of the frames' edges and
+    stay nearer them than ``seqinfo.ini``'s (below the mean of the two sizes on each axis): a
+    real downscale by 0.95, whose boxes reach about 1.05 times the frames, is not taken for
+    them, nor are boxes that stop short of the frames' edges (a detector's file of a scene
+    whose people keep to one side: too little to tell, the scale taken).
+    """
+    far = (1 + 1 / scale) / 2
+    return EDGE_REACH * cols <= right < far * cols and EDGE_REACH * rows <= bottom < far * rows
+
+
 def _refuse_scaled_off(
     cols: int,
     rows: int,
@@ -676,25 +702,42 @@ def _refuse_scaled_off(
     slack = 1 + SEQINFO_SLACK
     if right / applied > cols * slack or bottom / applied > rows * slack:
         return  # as given they do not fit the frames: the scale is theirs (PETS09's 0.625)
+    # the sequence whose seqinfo.ini the scale is (a --det-scale of another value: the user's)
+    seqinfo = (
+        sequence
+        if sequence is not None and sequence.width and abs(applied * sequence.width - cols) < 0.5
+        else None
+    )
+    fit = "as given they fit those frames"
     if right <= 0.5 * cols * slack and bottom <= 0.5 * rows * slack:  # overhanging a little
         where = f"lie in the top-left {right:.3g}x{bottom:.3g} pixels of the {cols}x{rows} frames"
         which = f"all {n} detection boxes"
     elif outside.mean() > OUTSIDE_SHARE and not as_xyxy.all():
         where = f"lie wholly outside the {cols}x{rows} frames (they reach {right:.0f}x{bottom:.0f})"
         which = f"{outside.sum()} of {n} detection boxes"
+    elif (
+        seqinfo is not None
+        and applied <= EDGE_MAX_SCALE
+        and _at_edges(right / applied, bottom / applied, cols, rows, applied)
+    ):
+        where = (
+            f"stop at {right:.0f}x{bottom:.0f}, short of the {cols}x{rows} frames' right and "
+            "bottom edges by the scale"
+        )
+        which, fit = f"all {n} detection boxes", "as given they reach those edges"
     else:
         return
     ini, why = "", ""
-    if sequence is not None and sequence.width and abs(applied * sequence.width - cols) < 0.5:
-        size = f"{sequence.width}x{sequence.height}" if sequence.height else f"{sequence.width}"
-        why = f" (the frames' width {cols} over imWidth={sequence.width} in "
-        why += f"{sequence.folder / 'seqinfo.ini'})"
+    if seqinfo is not None:
+        size = f"{seqinfo.width}x{seqinfo.height}" if seqinfo.height else f"{seqinfo.width}"
+        why = f" (the frames' width {cols} over imWidth={seqinfo.width} in "
+        why += f"{seqinfo.folder / 'seqinfo.ini'})"
         ini = (  # batch and eval scale gt.txt by it too: --det-scale 1 alone is not enough
             f": seqinfo.ini's {size} is not its images' size? correct it to {cols}x{rows} "
             "(gt.txt is scaled by it too), or"
         )
     raise ValueError(
-        f"{which}, scaled by {applied:g}{why}, {where}, and as given they fit those frames "
+        f"{which}, scaled by {applied:g}{why}, {where}, and {fit} "
         f"(they reach {right / applied:.0f}x{bottom / applied:.0f}): they are in the frames' "
         f"pixels already{ini or ';'} give --det-scale 1 / load_detections(scale=1)"
     )
