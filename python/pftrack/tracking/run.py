@@ -313,8 +313,10 @@ def track_frames(
                 def prepare(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
                     kept = tracker.working_frame(frame)
                     # from the pass's two threads too (next() is atomic), whose check of the
-                    # halves' joint reads a frame twice
-                    bar.set(min(next(read), n_prime))
+                    # halves' joint reads a frame twice; a batch's sequences draw no bar of
+                    # their own and count nothing here
+                    if bar.enabled:
+                        bar.set(min(next(read), n_prime))
                     return kept
 
                 primer = bootstrap_frames(
