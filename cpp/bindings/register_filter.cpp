@@ -207,7 +207,8 @@ void register_filter(py::module_& m) {
             RowMatrixXd out(k, 11);
             {
                 py::gil_scoped_release nogil;  // safe: raw buffers kept alive by `keep`
-                SisWorkspace ws(img.n_bins);  // one for all objects: no allocations per object
+                // one for all objects and frames: no allocations per object or frame
+                SisWorkspace& ws = thread_sis_workspace(img.n_bins);
                 for (py::ssize_t i = 0; i < k; ++i) {
                     auto& pa = keep[static_cast<size_t>(4 * i)];
                     auto& wa = keep[static_cast<size_t>(4 * i + 1)];

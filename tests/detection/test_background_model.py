@@ -90,10 +90,12 @@ def test_background_model_matches_reference_at_odd_widths(bins):
         rng = np.random.default_rng(cols)
         model, ref = _core.BackgroundModel(n_learn=2), BackgroundReference(n_learn=2)
         n_shadow = 0
-        for frame in random_scene(rng, shape=(40, cols)):
+        for k, frame in enumerate(random_scene(rng, shape=(40, cols))):
             _, mask = model.apply(frame, bins=bins)
             _, rmask = ref.apply(frame)
             np.testing.assert_array_equal(mask, rmask)
+            if k > 0:  # the histogram of |frame - background| (eight pixels at a time + rest)
+                np.testing.assert_array_equal(model.difference_histogram, ref.hist)
             np.testing.assert_array_equal(model.background, ref.background)
             assert model.threshold == pytest.approx(ref.threshold, abs=1e-12)
             n_shadow += int((mask == 127).sum())

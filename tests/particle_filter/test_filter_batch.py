@@ -5,6 +5,7 @@ the tracker's predict_tracks against LiveTrack.predict."""
 from __future__ import annotations
 
 import copy
+import threading
 
 import numpy as np
 import pytest
@@ -106,6 +107,46 @@ def test_batch_scratch_reused_across_objects_of_any_size(textured_frame, rng, mi
         np.testing.assert_array_equal(o["w"], s["w"])
         want = [*r["mean"], *r["map"], r["map_index"], r["ess"], r["rho_max"], r["rho_mean"]]
         np.testing.assert_array_equal(row, [*want, r["fg_mean"]])
+
+
+def _batch(image: _core.BinnedImage, objs: list[dict], min_samples: float) -> np.ndarray:
+    model = Ar2Model(sigma_xy=2.0, sigma_s=0.03)
+    args = (model.a, model.b, model.sigma, model.s_min, model.s_max, False, 20.0, "uniform", True)
+    return _core.sis_step_batch(
+        [o["p"] for o in objs], [o["w"] for o in objs], [o["m"] for o in objs], image,
+        [o["ref"] for o in objs], np.array([o["w0"] for o in objs]),
+        np.array([o["h0"] for o in objs]), *args, [o["seed"] for o in objs],
+        [o["step"] for o in objs], min_samples,
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize("min_samples", [0.0, 20.0])
+def test_batch_workspace_kept_across_calls_carries_nothing(textured_frame, rng, min_samples):
+    """The thread's workspace (integral tables, per-particle arrays) outlives a call: a step
+    after calls on other images (larger boxes, other bin counts, more particles) gives what
+    the first call of a fresh thread gives, bit for bit."""
+    image = hsv_bins(textured_frame)
+    objs = _objects(rng, image, 3)
+    fresh = copy.deepcopy(objs)
+    out: list[np.ndarray] = []
+    worker = threading.Thread(target=lambda: out.append(_batch(image, fresh, min_samples)))
+    worker.start()
+    worker.join()
+
+    big = np.tile(textured_frame, (3, 3, 1))  # larger regions, then other bins
+    for other in (hsv_bins(big), hsv_bins(big, binning=HsvBinning(n_h=6, n_s=6, n_v=4))):
+        others = _objects(rng, other, 4)
+        for o in others:
+            o["p"] = np.tile(o["p"], (5, 1))  # more particles than `objs` have
+            o["w"] = np.tile(o["w"], 5)
+            o["w0"], o["h0"] = 90.0, 120.0
+        _batch(other, others, min_samples)
+    again = _batch(image, objs, min_samples)
+    np.testing.assert_array_equal(again, out[0])
+    for o, f in zip(objs, fresh, strict=True):
+        np.testing.assert_array_equal(o["p"], f["p"])
+        np.testing.assert_array_equal(o["w"], f["w"])
+        np.testing.assert_array_equal(o["m"], f["m"])
 
 
 def test_batch_matches_numpy_composition(textured_frame, rng):

@@ -102,6 +102,7 @@ class BackgroundReference:
         self.background = bg + a * e
         self.previous = frame.copy()
         hist = np.bincount(np.minimum(d_bg.astype(np.int32), 255).ravel(), minlength=256)
+        self.hist = hist  # BackgroundModel.difference_histogram
         half = 0.5 * d_bg.size
         cum = np.concatenate([[0], np.cumsum(hist)])
         i = int(np.searchsorted(cum[1:], half))  # first bin whose cumulative count >= half

@@ -496,8 +496,12 @@ public:
             if (o != nullptr)
                 for (Index x = 0; x < cols; ++x)
                     o[x] = static_cast<std::int16_t>(lut_.bin_at(si[x], hi[x]));
-            for (Index x = 0; x < cols; ++x)
-                ++h8[static_cast<size_t>(x & 7)][static_cast<size_t>(di[x])];
+            //     pixel x into copy x mod 8: eight at a time, each copy's address fixed (was
+            //     9 instructions a pixel, the copy's address computed from x; now about 2.4)
+            Index x = 0;
+            for (; x + 8 <= cols; x += 8)
+                for (size_t q = 0; q < 8; ++q) ++h8[q][static_cast<size_t>(di[x + static_cast<Index>(q)])];
+            for (; x < cols; ++x) ++h8[static_cast<size_t>(x & 7)][static_cast<size_t>(di[x])];
             // (5) background_c += a (frame_c - background_c), vectorised (selective update)
             if (hold != nullptr)
                 detail::background_row_update_held(cols, fb, fg, fr, qb, qg, qr, cand,

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -37,6 +38,8 @@ public:
     static constexpr int kLanes = 8;  // uint16 lanes of a 128-bit vector
     /// Largest box (pixels) whose counts are exact in uint16.
     static constexpr Index kMaxBoxPixels = 65535;
+    /// Table entries a grown buffer rounds up to at most (for_each_range_count's cap).
+    static constexpr size_t kMaxTableEntries = size_t(1) << 22;
 
     explicit IntegralHistogram(int n_bins)
         : n_bins_(n_bins), local_of_(static_cast<size_t>(n_bins) + 1),
@@ -88,9 +91,9 @@ public:
     void build(const BinImage& img) {
         const Index w = region_.x1 - region_.x0, h = region_.y1 - region_.y0;
         row_len_ = (w + 1) * stride_;
-        table_.resize(static_cast<size_t>((h + 1) * row_len_));
+        reserve_table(static_cast<size_t>((h + 1) * row_len_));
         local_.resize(static_cast<size_t>(stride_));
-        std::uint16_t* t = table_.data();
+        std::uint16_t* t = table_.get();
         std::fill(t, t + row_len_, std::uint16_t(0));
         std::vector<std::uint16_t>& run = local_;  // the running row histogram
         const std::int16_t* local_of = local_of_.data() + 1;
@@ -133,7 +136,7 @@ public:
     void box_counts(const PixelRange& r, std::int32_t* c) {
         const Index x0 = r.x0 - region_.x0, x1 = r.x1 - region_.x0;
         const Index y0 = r.y0 - region_.y0, y1 = r.y1 - region_.y0;
-        const std::uint16_t* t = table_.data();
+        const std::uint16_t* t = table_.get();
         const std::uint16_t* a = t + y0 * row_len_ + x0 * stride_;
         const std::uint16_t* b = t + y0 * row_len_ + x1 * stride_;
         const std::uint16_t* d = t + y1 * row_len_ + x0 * stride_;
@@ -157,6 +160,15 @@ public:
     }
 
 private:
+    /// Room for `entries` table entries, left as they are: build() writes every entry it
+    /// reads (a std::vector's resize zeroed each growth, and copied the old table over, for
+    /// each object's region on every frame).
+    void reserve_table(size_t entries) {
+        if (entries <= table_capacity_) return;
+        table_capacity_ = std::max(entries, std::min(2 * table_capacity_, kMaxTableEntries));
+        table_.reset(new std::uint16_t[table_capacity_]);  // default-initialised: not zeroed
+    }
+
 #if defined(__SSE2__)
     /// build() with V vectors of bins: the running row histogram stays in V registers, and
     /// pixel of compact bin l adds (lane == l) to each, a compare and a subtract per vector
@@ -168,7 +180,7 @@ private:
         for (int j = 0; j < V; ++j)
             lane[j] = _mm_add_epi16(_mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7),
                                     _mm_set1_epi16(static_cast<short>(j * kLanes)));
-        std::uint16_t* t = table_.data();
+        std::uint16_t* t = table_.get();
         for (Index y = 0; y < h; ++y) {
             const std::uint16_t* above = t + y * row_len_ + V * kLanes;
             std::uint16_t* cur = t + (y + 1) * row_len_;
@@ -223,7 +235,8 @@ private:
     std::vector<std::uint8_t> seen_;         // bin + 1 -> present in the region
     std::vector<std::int16_t> bin_of_local_;  // compact index -> bin (-1: background)
     std::vector<std::int16_t> lanes_;        // the bins >= 0 present, by partial sum (present())
-    std::vector<std::uint16_t> table_;       // (h + 1) x (w + 1) x stride_
+    std::unique_ptr<std::uint16_t[]> table_;  // (h + 1) x (w + 1) x stride_ (of a larger buffer)
+    size_t table_capacity_ = 0;
     std::vector<std::uint16_t> local_;       // one box's (or one row's running) compact counts
 };
 

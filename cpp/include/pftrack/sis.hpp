@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "histogram.hpp"
@@ -52,13 +53,21 @@ inline void check_particle_set(const Eigen::Ref<const RowMatrixXd>& particles,
 
 /// Systematic resampling of the rows of `particles` by `weights`, with the stream's uniform of
 /// index 2^64 - 1 (outside the range the normals use). Weights are left to the caller.
+/// `kept`: scratch for the rows kept (resized to the particles' shape).
+inline void resample_systematic_in_place(Eigen::Ref<RowMatrixXd> particles,
+                                         const Eigen::Ref<const Eigen::VectorXd>& weights,
+                                         const CounterRng& rng, RowMatrixXd& kept) {
+    const IndexVector idx = systematic_resample(weights, rng.uniform(~std::uint64_t(0)));
+    kept.resize(particles.rows(), kParticleCols);
+    for (Index i = 0; i < particles.rows(); ++i) kept.row(i) = particles.row(idx(i));
+    particles = kept;
+}
+
 inline void resample_systematic_in_place(Eigen::Ref<RowMatrixXd> particles,
                                          const Eigen::Ref<const Eigen::VectorXd>& weights,
                                          const CounterRng& rng) {
-    const IndexVector idx = systematic_resample(weights, rng.uniform(~std::uint64_t(0)));
-    RowMatrixXd kept(particles.rows(), kParticleCols);
-    for (Index i = 0; i < particles.rows(); ++i) kept.row(i) = particles.row(idx(i));
-    particles = kept;
+    RowMatrixXd kept;
+    resample_systematic_in_place(particles, weights, rng, kept);
 }
 
 struct SisParams {
@@ -95,28 +104,40 @@ inline Eigen::VectorXd sis_checked(const Eigen::Ref<const RowMatrixXd>& particle
     return sqrt_reference(ref, img.n_bins, fn);
 }
 
-/// Scratch space of the box counts that successive steps on images of `n_bins` bins reuse
-/// (sis_step_batch: one for all objects of the frame).
+/// Scratch space that successive steps on images of `n_bins` bins reuse (sis_step_batch: one
+/// for all objects of the frame): the box counts', and the per-particle arrays', resized per
+/// step (no allocation when the particle count stays).
 struct SisWorkspace {
     explicit SisWorkspace(int n_bins) : scratch(n_bins), table(n_bins) {}
     HistogramScratch scratch;
     IntegralHistogram table;
+    RowMatrixXd kept, boxes;  // resampled rows; particle boxes (cx, cy, w, h)
+    Eigen::VectorXd rho, counted, logw;
 };
 
+/// The calling thread's workspace for images of `n_bins` bins, kept from call to call: one
+/// made per call (per frame, in sis_step_batch) allocated its table anew, up to megabytes.
+inline SisWorkspace& thread_sis_workspace(int n_bins) {
+    thread_local std::unique_ptr<SisWorkspace> ws;
+    if (!ws || ws->table.n_bins() != n_bins) ws = std::make_unique<SisWorkspace>(n_bins);
+    return *ws;
+}
+
 /// sis_step of values `sis_checked` accepted (`sqref`: what it returned). `ws`: scratch space
-/// of the caller's for img.n_bins bins, else a local one.
+/// of the caller's for img.n_bins bins, else the thread's (thread_sis_workspace).
 inline SisResult sis_step_checked(Eigen::Ref<RowMatrixXd> particles,
                                   Eigen::Ref<Eigen::VectorXd> weights,
                                   Eigen::Ref<RowMatrixXd> means, const BinImage& img,
                                   const Eigen::VectorXd& sqref, const SisParams& prm,
                                   std::uint64_t seed, std::uint64_t step,
                                   SisWorkspace* ws = nullptr) {
+    if (ws == nullptr || ws->table.n_bins() != img.n_bins) ws = &thread_sis_workspace(img.n_bins);
     const char* fn = "sis_step";
     const Index n = particles.rows();
     const CounterRng rng(seed, step);
     // 1. resample
     if (prm.resample) {
-        resample_systematic_in_place(particles, weights, rng);
+        resample_systematic_in_place(particles, weights, rng, ws->kept);
         weights.setConstant(1.0 / static_cast<double>(n));
     }
     // 2. propagate
@@ -131,7 +152,8 @@ inline SisResult sis_step_checked(Eigen::Ref<RowMatrixXd> particles,
     // 3-4. histogram and weigh: log w_i = log w_i(resampled) - lambda D_i^2
     //    (the particles' boxes overlap: box_coefficients may count them from one integral
     //    histogram of their union)
-    RowMatrixXd boxes(n, 4);
+    RowMatrixXd& boxes = ws->boxes;
+    boxes.resize(n, 4);
     for (Index i = 0; i < n; ++i) {
         const double s = particles(i, 2);
         boxes.row(i) << particles(i, 0), particles(i, 1), s * prm.w0, s * prm.h0;
@@ -139,14 +161,17 @@ inline SisResult sis_step_checked(Eigen::Ref<RowMatrixXd> particles,
     //    Large boxes are counted on a lattice, one step for all particles (from the box of the
     //    previous mean state): the cost per particle stays near min_samples points.
     const Index lattice = lattice_step(m1(2) * prm.w0, m1(2) * prm.h0, prm.min_samples);
-    Eigen::VectorXd rho(n), counted(n), logw(n);
-    const bool shared = ws != nullptr && ws->table.n_bins() == img.n_bins;
+    Eigen::VectorXd &rho = ws->rho, &counted = ws->counted, &logw = ws->logw;
+    rho.resize(n);
+    counted.resize(n);
+    logw.resize(n);
     box_coefficients(img, boxes, sqref.data(), prm.kernel, BoxPath::kAuto, rho.data(),
-                     counted.data(), lattice, shared ? &ws->scratch : nullptr,
-                     shared ? &ws->table : nullptr);
+                     counted.data(), lattice, &ws->scratch, &ws->table);
+    //    resampled, every weight is 1/N: one log for all (the same call, so the same bits)
+    const double log_uniform = prm.resample ? std::log(weights(0)) : 0.0;
     for (Index i = 0; i < n; ++i) {
         const double d = bhattacharyya_distance_from_rho(rho(i));
-        logw(i) = std::log(weights(i)) - prm.lambda * d * d;
+        logw(i) = (prm.resample ? log_uniform : std::log(weights(i))) - prm.lambda * d * d;
     }
     normalise_log_weights(logw, fn);
     weights = logw;
