@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "pftrack/sis.hpp"
+#include "arguments.hpp"
 #include "arrays.hpp"
 #include "step_args.hpp"
 
@@ -25,12 +26,14 @@ py::array_t<double> batch_item(const py::handle& h, const char* what, py::ssize_
     // every message (the item's name, the dtype's) built only on failure: this runs for each
     // object on every frame
     const auto name = [&] { return std::string(what) + "[" + std::to_string(k) + "]"; };
-    if (!py::isinstance<py::array>(h)) fail(fn, name() + " must be a NumPy array");
+    // a wrong type or dtype is a TypeError and a layout it cannot write through a ValueError,
+    // as from propagate, sis_step and mh_step (was a ValueError "particles[1] dtype is float32")
+    if (!(py::isinstance<py::array>(h) &&
+          bind::is_dtype<double>(py::reinterpret_borrow<py::array>(h).dtype()) &&
+          (py::reinterpret_borrow<py::array>(h).flags() & py::array::c_style) != 0 &&
+          py::reinterpret_borrow<py::array>(h).writeable()))
+        bind::inplace_f64(h, fn, name().c_str(), cols == 0 ? 1 : 2);  // throws, naming it
     const auto a = py::reinterpret_borrow<py::array>(h);
-    if (!bind::is_dtype<double>(a.dtype()))
-        require(false, fn, (name() + " dtype").c_str(), bind::dtype_name(a), "float64");
-    if (!((a.flags() & py::array::c_style) != 0 && a.writeable()))
-        fail(fn, name() + " must be C-contiguous and writeable");
     if (cols == 0) {
         if (!(a.ndim() == 1 && (rows < 0 || a.shape(0) == rows)))
             fail(fn, name() + " must have shape (N,), N the particles' rows");
@@ -168,8 +171,12 @@ void register_filter(py::module_& m) {
                 keep.push_back(p);
                 keep.push_back(batch_item(weights[i], "weights", i, n, 0));
                 keep.push_back(batch_item(means[i], "means", i, 2, kStateDim));
-                auto r = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
-                    refs[i]);
+                // cast (one copy) when not float64, but complex or text refused, as for sis_step
+                const py::handle ri = refs[i];
+                if (!(py::isinstance<py::array>(ri) &&
+                      bind::real_kind(py::reinterpret_borrow<py::array>(ri).dtype().kind())))
+                    bind::check_real(ri, fn, "refs[" + std::to_string(i) + "]");
+                auto r = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(ri);
                 if (!(r && r.ndim() == 1))
                     fail(fn, "refs[" + std::to_string(i) + "] must be a (B,) float array");
                 keep.push_back(r);

@@ -76,7 +76,12 @@ def test_reseed_batch_clamps_the_scale():
         ({"pos_sd": -1.0}, "pos_sd and s_sd"),
         ({"s_min": 3.0}, "scale bounds"),
         ({"w0": np.ones(2)}, "one entry per object"),
-        ({"particles": [np.zeros((5, 6), np.float32)]}, r"particles\[0\] dtype"),
+        # a TypeError now (was ValueError "particles[0] dtype is float32"), as from sis_step
+        (
+            {"particles": [np.zeros((5, 6), np.float32)]},
+            r"^reseed_batch: particles\[0\] must be a C-contiguous, .* got dtype float32$",
+        ),
+        ({"boxes": np.ones((1, 4), complex)}, r"^reseed_batch: boxes must hold real numbers"),
         ({"weights": [np.zeros(4)]}, r"weights\[0\] must have shape \(N,\)"),
         ({"means": [np.zeros((3, 3))]}, r"means\[0\] must have shape \(2, 3\)"),
     ],
@@ -98,6 +103,7 @@ def test_reseed_batch_refuses_bad_input_before_writing(change, match):
         "s_max": 2.0,
     }
     kw.update(change)
-    with pytest.raises(ValueError, match=match):
+    kind = TypeError if "dtype" in match or "real" in match else ValueError
+    with pytest.raises(kind, match=match):
         _core.reseed_batch(**kw)
     assert (particles[0] == -7.0).all() and (weights[0] == -7.0).all()  # nothing written

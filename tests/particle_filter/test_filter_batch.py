@@ -5,6 +5,7 @@ the tracker's predict_tracks against LiveTrack.predict."""
 from __future__ import annotations
 
 import copy
+import re
 import threading
 
 import numpy as np
@@ -210,11 +211,20 @@ def test_batch_rejects_bad_input_and_changes_nothing(textured_frame, rng):
     ps, ws, seeds = [o["p"] for o in objs], [o["w"] for o in objs], [o["seed"] for o in objs]
     with pytest.raises(ValueError, match="one entry per object"):
         call(ps, ws, seeds[:1])
-    with pytest.raises(ValueError, match=r"particles\[1\] dtype"):
+    # a wrong dtype is a TypeError (was ValueError "particles[1] dtype is float32"), a layout
+    # it cannot write through a ValueError, as from sis_step and propagate
+    inplace = re.escape(
+        "must be a C-contiguous, writeable float64 array (updated in place, never copied)"
+    )
+    with pytest.raises(
+        TypeError, match=rf"^sis_step_batch: particles\[1\] {inplace}, got dtype float32$"
+    ):
         call([ps[0], ps[1].astype(np.float32)], ws, seeds)
+    with pytest.raises(TypeError, match=r"^sis_step_batch: weights\[0\] .*, got list$"):
+        call(ps, [ws[0].tolist(), ws[1]], seeds)
     with pytest.raises(ValueError, match=r"weights\[1\] must have shape"):
         call(ps, [ws[0], ws[1][:-1]], seeds)
-    with pytest.raises(ValueError, match=r"particles\[0\] must be C-contiguous"):
+    with pytest.raises(ValueError, match=rf"particles\[0\] {inplace}, got one not C-contiguous"):
         call([np.asfortranarray(ps[0]), ps[1]], ws, seeds)
     # the values sis_step checks, in the entry after one that would step (were: entry 0 had
     # stepped when entry 1 was refused)
