@@ -185,4 +185,31 @@ private:
     }
 };
 
+/// A numeric array's kinds: booleans, integers, floats (complex numbers, objects, text, bytes,
+/// datetimes and records are not).
+inline bool real_kind(char kind) {
+    return kind == 'b' || kind == 'i' || kind == 'u' || kind == 'f';
+}
+
+/// TypeError when `h` (argument `what` of `fn`) is an array, or a list or buffer NumPy reads as
+/// one, of a kind that is not real numbers (NumPy's cast took a complex array's real part with
+/// only a ComplexWarning, and parsed text as numbers). A valid ndarray costs one kind read.
+inline void check_real(py::handle h, const std::string& fn, const std::string& what) {
+    if (py::isinstance<py::array>(h)) {
+        const py::dtype d = py::reinterpret_borrow<py::array>(h).dtype();
+        if (real_kind(d.kind())) return;
+        throw py::type_error(fn + ": " + what + " must hold real numbers, got dtype " +
+                             py::str(d).cast<std::string>());
+    }
+    if (!(PyList_Check(h.ptr()) || PyTuple_Check(h.ptr()) || PyObject_CheckBuffer(h.ptr())))
+        return;
+    py::object a;
+    try {
+        a = py::module_::import("numpy").attr("asarray")(h);
+    } catch (const py::error_already_set&) {
+        return;  // ragged or unreadable: the conversion that follows fails and says so
+    }
+    check_real(a, fn, what);
+}
+
 }  // namespace pftrack::bind

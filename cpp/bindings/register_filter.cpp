@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "pftrack/sis.hpp"
-#include "arguments.hpp"
 #include "arrays.hpp"
 #include "step_args.hpp"
 
