@@ -103,14 +103,15 @@ def keep_plot_background(kept: list[Any], frame: Any) -> None:
     picture (frame 1). A frame is dark as the built-in detector counts it
     (:func:`pftrack.detection.light.is_dark`); the first frame is kept until a frame that is
     not dark comes, so a video dark throughout is drawn on its first frame, as before. Each
-    frame is looked at only while the one kept is dark.
+    frame is looked at only while the one kept is dark; `kept` holds the frame and whether it
+    is dark (``kept[0]``, ``kept[1]``: the kept frame's darkness measured once, not per frame).
     """
     from pftrack.detection.light import is_dark
 
     if not kept:
-        kept.append(frame.copy())
-    elif is_dark(kept[0]) and not is_dark(frame):
-        kept[0] = frame.copy()
+        kept.extend((frame.copy(), is_dark(frame)))
+    elif kept[1] and not is_dark(frame):
+        kept[:] = [frame.copy(), False]
 
 
 class _StopOnCtrlC:
