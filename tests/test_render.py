@@ -582,3 +582,37 @@ def test_a_long_title_is_wrapped_on_a_narrow_frame(tmp_path: Path) -> None:
     assert ink[:, 1].max() <= 320 - 5  # inside the frame, with its margin
     assert ink[:, 0].max() > 20  # on a second line
     assert title_ink(640)[:, 0].max() <= 20  # one line where the frame is wide enough
+
+
+@pytest.mark.parametrize("background", [False, True])
+def test_plot_ids_of_paths_that_begin_or_end_together_do_not_overlap(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, background: bool
+) -> None:
+    """Was (trial61): ids drawn on top of one another at the plot's right edge, where people
+    walk in together. Three tracks from one spot past the right edge to one spot in the middle:
+    their id tags (and those of three more from one spot mid-plot) are moved apart, inside it."""
+    import pftrack.render as render
+
+    boxes: list[tuple[int, int, int, int]] = []
+
+    def spy(*args: Any, **kwargs: Any) -> tuple[int, int, int, int]:
+        box = tag(*args, **kwargs)
+        boxes.append(box)
+        return box
+
+    tag = render._tag
+    monkeypatch.setattr(render, "_tag", spy)
+    rows = np.array(
+        [[f, tid, left, 40.0 + 2 * f, 20.0, 40.0] for tid in (1, 2, 3, 104, 105, 106)
+         for f, left in ((1, 195.0 if tid < 100 else 80.0), (2, 90.0))],
+    )  # fmt: skip
+    if background:
+        plot_trajectories(tmp_path / "p.png", rows, np.full((150, 200, 3), 90, np.uint8))
+    else:
+        plot_trajectories(tmp_path / "p.png", rows, size=(200, 150))
+    assert len(boxes) == 6
+    for i, a in enumerate(boxes):
+        assert 0 <= a[0] <= a[2] < 200 and 0 <= a[1] <= a[3] < 150, a  # whole inside
+        for b in boxes[:i]:
+            apart = a[2] < b[0] or b[2] < a[0] or a[3] < b[1] or b[3] < a[1]
+            assert apart, (a, b)

@@ -63,7 +63,14 @@ void register_histogram(py::module_& m) {
                      throw py::type_error(std::string(fn) + ": n_bins must be an int, got " +
                                           py::str(py::type::of(n_in).attr("__name__")).cast<std::string>());
                  const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(n_in.ptr()));
-                 if (!index) throw py::error_already_set();
+                 if (!index) {  // an array of floats, or of several values: was NumPy's "only
+                     PyErr_Clear();  // integer scalar arrays can be converted ...", no name
+                     const py::array a = py::array::ensure(n_in);
+                     throw py::type_error(
+                         std::string(fn) + ": n_bins must be an int, got " +
+                         py::str(py::type::of(n_in).attr("__name__")).cast<std::string>() +
+                         (a ? " of " + bind::dtype_name(a) : ""));
+                 }
                  int overflow = 0;
                  const long long wide = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
                  if (overflow != 0 || wide < 1 || wide > 32767)

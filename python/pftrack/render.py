@@ -35,6 +35,8 @@ __all__ = [
     "write_annotated_video",
 ]
 
+Box = tuple[int, int, int, int]  # a drawn tag's pixels: x0, y0, x1, y1, inclusive
+
 
 @functools.lru_cache(maxsize=4096)
 def colour_of(track_id: int) -> tuple[int, int, int]:
@@ -132,24 +134,49 @@ def _tag(
     colour: tuple[int, int, int],
     k: int,
     size: tuple[tuple[int, int], int] | None = None,
-) -> None:
+    taken: list[Box] | None = None,
+) -> Box:
     """`text` near `org` (its baseline's left end) on a box of `colour`, in black or white.
 
     Legible on any frame (was: a white frame number on a white frame, a coloured id on that
     colour): the ink is whichever of black and white stands out of `colour` more; `k` is the
     ink's thickness and the box's margin. The tag is moved the least that puts it whole inside
     `image` (a box's id on a box partly outside the frame, a path's id at a point outside the
-    plot). `size`: :func:`_text_size` of `text`, when the caller has it.
+    plot). `size`: :func:`_text_size` of `text`, when the caller has it. `taken`: the boxes of
+    the tags drawn before, which this one is moved up or down the least to miss, when there is
+    room (:func:`_free_y`), and joins. Returns the tag's box (x0, y0, x1, y1), inclusive.
     """
     (tw, th), base = _text_size(text, scale, k) if size is None else size
     x = max(k, min(org[0], image.shape[1] - tw - k))
     y = min(max(th + k, org[1]), image.shape[0] - base - k)
-    cv2.rectangle(image, (x - k, y - th - k), (x + tw + k - 1, y + base), colour, -1)
+    if taken:
+        y = _free_y(taken, x - k, x + tw + k - 1, y, th + k, base, image.shape[0])
+    box = (x - k, y - th - k, x + tw + k - 1, y + base)
+    if taken is not None:
+        taken.append(box)
+    cv2.rectangle(image, box[:2], box[2:], colour, -1)
     luma = 0.114 * colour[0] + 0.587 * colour[1] + 0.299 * colour[2]  # BT.601, BGR
     ink = (0, 0, 0) if luma > 127 else (255, 255, 255)
     cv2.putText(
         image, text_for_opencv(text), (x, y), cv2.FONT_HERSHEY_SIMPLEX, scale, ink, k, cv2.LINE_AA
     )
+    return box
+
+
+def _free_y(taken: list[Box], x0: int, x1: int, y: int, above: int, below: int, rows: int) -> int:
+    """The baseline nearest `y` whose tag, `above` rows over it and `below` under, misses `taken`.
+
+    The tag spans columns `x0` to `x1`; only baselines that keep it inside `rows` rows are
+    tried: `y` itself, and just under or just over each box of `taken` (the nearest free place
+    is one of them). None free (a crowd of tags taller than the image): `y`.
+    """
+
+    def free(b: int) -> bool:
+        return all(x1 < t[0] or t[2] < x0 or b + below < t[1] or t[3] < b - above for t in taken)
+
+    inside = range(above, rows - below)
+    tries = [y] + [t[3] + above + 1 for t in taken] + [t[1] - below - 1 for t in taken]
+    return next((b for b in sorted(tries, key=lambda b: abs(b - y)) if b in inside and free(b)), y)
 
 
 def _dashed_rectangle(
@@ -694,8 +721,12 @@ def plot_trajectories(
         cv2.circle(canvas, tuple(int(v) for v in pts[-1]), 3, c, -1)
     # each id at its path's first point, on a tag of its colour, over every path, whole inside
     # the canvas (was: the id's colour on the dimmed frame, off it for a track from outside)
+    # (was: drawn over one another where paths begin together, at a door or the image's side)
+    taken: list[Box] = []  # the tags drawn so far: each misses them when there is room
     for tid, (_, pts, _) in drawn.items():
-        _tag(canvas, str(tid), (int(pts[0][0]), int(pts[0][1])), 0.4, colour_of(tid), 1)
+        _tag(
+            canvas, str(tid), (int(pts[0][0]), int(pts[0][1])), 0.4, colour_of(tid), 1, None, taken
+        )
     if background is None:
         canvas = _with_axes(canvas, title)
     elif title:  # on as many lines as the frame's width needs (was: cut at its right edge)

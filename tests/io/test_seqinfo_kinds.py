@@ -10,7 +10,8 @@
   a det.txt in the frames' pixels scaled the boxes by 0.8 with only a note, exit 0: refused now
   (tracking.run's ``_at_edges``: the boxes as given reach the frames' right and bottom edges),
   and the rule leaves every real sequence's det.txt in its seqinfo.ini's pixels scaled onto
-  frames of 0.5 to 0.99 times that size (docs/robustness.md).
+  frames of 0.5 to 0.99 times that size (docs/robustness.md). A ``--det-scale 0.8`` the user
+  gives, seqinfo.ini's ratio, was refused the same way; it is taken now (the user's word).
 """
 
 from __future__ import annotations
@@ -24,7 +25,13 @@ import pytest
 
 from pftrack.cli import main
 from pftrack.io.video import find_sequence, read_seqinfo
-from pftrack.tracking.run import EDGE_MAX_SCALE, _check_layout, _Scaled, load_detections
+from pftrack.tracking.run import (
+    EDGE_MAX_SCALE,
+    SeqinfoScale,
+    _check_layout,
+    _Scaled,
+    load_detections,
+)
 from tests.conftest import dataset
 
 INI = (
@@ -102,6 +109,35 @@ def test_a_seqinfo_larger_than_its_frames_beside_their_detections_is_refused(
     assert main([*argv, "--det-scale", "0.7"]) == 0  # another scale than seqinfo's: the user's
 
 
+def test_a_det_scale_stated_equal_to_seqinfo_s_ratio_is_taken(tmp_path: Path) -> None:
+    """Was refused as the automatic scale 0.8 is above (left61, frames61): a user who states
+    the scale seqinfo.ini gives says the boxes are in its pixels; only the scale nobody gave is
+    doubted. The Python API alike: load_detections(scale=0.8) is stated."""
+    tud = dataset("tud-campus")
+    seq = tmp_path / "tud125"
+    seq.mkdir()
+    shutil.copy(tud / "det.txt", seq / "det.txt")
+    (seq / "video.mp4").symlink_to(tud / "video.mp4")
+    ini = (tud / "seqinfo.ini").read_text()
+    (seq / "seqinfo.ini").write_text(
+        ini.replace("imWidth=640", "imWidth=800").replace("imHeight=480", "imHeight=600")
+    )
+    out = tmp_path / "t.txt"
+    argv = ["-q", "track", str(seq), "--detections", str(seq / "det.txt"), "--out", str(out)]
+    assert main([*argv, "--det-scale", "0.8"]) == 0
+    rows = np.loadtxt(out, delimiter=",", ndmin=2)
+    assert len(rows) and (rows[:, 2] + rows[:, 4]).max() < 540  # scaled by 0.8: reach 511
+    info = read_seqinfo(seq)
+    for scale, refused in ((0.8, False), (SeqinfoScale(0.8), True)):
+        dets = load_detections(seq / "det.txt", scale)
+        assert getattr(dets, "stated", None) is not refused
+        if refused:
+            with pytest.raises(ValueError, match="they are in the frames' pixels already"):
+                _check_layout(dets, (480, 640, 3), info)
+        else:
+            _check_layout(dets, (480, 640, 3), info)
+
+
 @pytest.mark.parametrize(
     "name",
     ["pets09-s2l1", "tud-campus", "mot15-gt/ADL-Rundle-6", "mot15-gt/ETH-Sunnyday",
@@ -120,9 +156,16 @@ def test_the_edge_rule_on_every_real_det_txt(name: str) -> None:
         applied = cols / info.width
         own = load_detections(folder / "det.txt", applied)
         _check_layout(own, (rows, cols, 3), info)  # not refused
-        in_frames = _Scaled(dict(load_detections(folder / "det.txt", applied**2)), applied)
+        in_frames = dict(load_detections(folder / "det.txt", applied**2))
+        auto = _Scaled(in_frames, applied, stated=False)  # seqinfo.ini's, as pftrack track's
         if applied <= EDGE_MAX_SCALE:
             with pytest.raises(ValueError, match="they are in the frames' pixels already"):
-                _check_layout(in_frames, (rows, cols, 3), info)
+                _check_layout(auto, (rows, cols, 3), info)
         else:
-            _check_layout(in_frames, (rows, cols, 3), info)
+            _check_layout(auto, (rows, cols, 3), info)
+        stated = _Scaled(in_frames, applied)  # --det-scale: taken, but at 0.5 (all boxes in
+        if s == 0.5:  # the top-left quarter: refused whoever gave the scale)
+            with pytest.raises(ValueError, match="lie in the top-left"):
+                _check_layout(stated, (rows, cols, 3), info)
+        else:
+            _check_layout(stated, (rows, cols, 3), info)

@@ -365,7 +365,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     from pftrack.io.mot import as_written, read_mot
     from pftrack.io.video import FrameSource, info_scale, read_seqinfo
     from pftrack.recovery.linking import check_scored_ids
-    from pftrack.tracking.run import track_path
+    from pftrack.tracking.run import SeqinfoScale, track_path
 
     cpu = time.process_time()
     report, stop = running_task()
@@ -378,7 +378,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         (frames.width, frames.height), (seq.image_width, seq.image_height), seq.name
     )
     det = seq.detections if options.detections == "auto" else None
-    det_scale = options.det_scale if options.det_scale is not None else auto_scale
+    det_scale = options.det_scale if options.det_scale is not None else SeqinfoScale(auto_scale)
     # the ground truth's pixels: seqinfo.ini's size when it gives one, else those of the given
     # detections' scale (det.txt and gt.txt of one sequence share them; was: 1, and MOTA -100
     # for ground truth of twice the frames' size, a user trial)

@@ -215,6 +215,7 @@ def _det_scale(args: argparse.Namespace, source: Any, det_path: str, said: list[
     if own is None or seq.width is None or not own.samefile(det_path):
         return 1.0
     from pftrack.io.video import info_scale
+    from pftrack.tracking.run import SeqinfoScale
 
     scale = info_scale(
         (source.width, source.height), (seq.width, seq.height), seq.folder / "seqinfo.ini"
@@ -225,7 +226,7 @@ def _det_scale(args: argparse.Namespace, source: Any, det_path: str, said: list[
         f"detections scaled by {scale:g}: frames are {source.width} px wide, "
         f"{seq.folder / 'seqinfo.ini'} says imWidth={seq.width} (--det-scale overrides)"
     )
-    return scale
+    return SeqinfoScale(scale)  # not stated: its boxes may be refused at the frames' edges
 
 
 def _check_outputs(args: argparse.Namespace, live: bool) -> None:

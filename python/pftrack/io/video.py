@@ -1397,6 +1397,69 @@ def _jpeg_ends(data: bytes) -> bool | None:
     return False
 
 
+#: JPEG start-of-frame markers (``FF C0``-``FF CF`` but DHT C4, JPG C8, DAC CC): the image's size.
+_JPEG_SOF = frozenset(range(0xC0, 0xD0)) - {0xC4, 0xC8, 0xCC}
+
+
+def _header_size(path: Path) -> tuple[int, int] | None:
+    """(width, height) of a PNG or JPEG file from its header, as stored; None if not told.
+
+    A few bytes a file: PNG's IHDR (bytes 16-24), JPEG's start-of-frame segment, walked to
+    marker by marker from the start, each segment skipped by its length (EXIF's thumbnail
+    unread). Not told: another format, a file too short or damaged there (read as a frame, it
+    is refused or stood in for then, as before). As stored: OpenCV turns a JPEG by its EXIF
+    orientation as it reads it, so a size that is the other's turned is not told apart here.
+    """
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(24)
+            if head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR":
+                w, h = int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+                return (w, h) if w and h else None
+            if head[:2] != b"\xff\xd8":
+                return None
+            fh.seek(2)
+            for _ in range(1000):  # segments before the frame's (a damaged file: not told)
+                marker = fh.read(4)
+                if len(marker) < 4 or marker[0] != 0xFF:
+                    return None
+                if marker[1] == 0xFF or 0xD0 <= marker[1] <= 0xD7 or marker[1] == 0x01:
+                    fh.seek(-3 if marker[1] == 0xFF else -2, os.SEEK_CUR)  # fill, no length
+                    continue
+                length = int.from_bytes(marker[2:4], "big")
+                if marker[1] in _JPEG_SOF:
+                    frame = fh.read(5)  # precision, height, width
+                    if len(frame) < 5:
+                        return None
+                    w, h = int.from_bytes(frame[3:5], "big"), int.from_bytes(frame[1:3], "big")
+                    return (w, h) if w and h else None
+                if marker[1] in (0xD9, 0xDA) or length < 2:  # end or scan before a frame
+                    return None
+                fh.seek(length - 2, os.SEEK_CUR)
+    except OSError:
+        return None
+    return None
+
+
+def _odd_size(images: Sequence[Path], first: int) -> tuple[Path, tuple[int, int]] | None:
+    """The first image of a folder whose header's size is another than image `first`'s.
+
+    :func:`_header_size` of each (PNG and JPEG; another format, or one not told, is checked
+    when read, :meth:`FrameSource._read_image`). A size that is the other turned (``480x640``
+    beside ``640x480``) is left to the read: an EXIF orientation may turn it back. Returns the
+    image and its size, or None.
+    """
+    size = _header_size(images[first])
+    if size is None:
+        return None
+    turned = size[::-1]
+    for path in images:
+        other = _header_size(path)
+        if other is not None and other != size and other != turned:
+            return path, other
+    return None
+
+
 def _odd_depth(path: Path) -> str | None:
     """The depth of image `path` if it decodes only at a depth other than 8 or 16 bits.
 
@@ -1716,7 +1779,9 @@ class FrameSource:
         If it is empty or a negative camera index; if it cannot be opened or decoded, or holds
         no frame (an image folder none of whose images can be read: the count and the first's
         reason); if two images of a folder have one number, or another size than the first
-        that can be read, or are 16-bit where it is 8-bit (when read); or if a MOTChallenge
+        that can be read (a PNG or JPEG when the folder is opened, from its header,
+        :func:`_odd_size`; another when read), or are 16-bit where it is 8-bit (when read); or
+        if a MOTChallenge
         sequence's image folder is named by number and one is missing (a hole in the
         numbering, numbers that do not start at 1 or a count other than ``seqLength``); if
         read (iterated, :meth:`frames_at`) after :meth:`stop`.
@@ -1923,6 +1988,13 @@ class FrameSource:
                 continue
             self._image_shape = (int(first.shape[0]), int(first.shape[1]))
             self.lead_black = k
+            odd = _odd_size(self._images, k)  # before any work (was: when reached, minutes on)
+            if odd is not None:
+                w0, h0 = _header_size(path) or (0, 0)
+                raise ValueError(
+                    f"image {odd[0]} is {odd[1][0]}x{odd[1][1]} but {path.name} is {w0}x{h0}: "
+                    "every image of a folder must have one size"
+                )
             return first, len(self._images)
         if len(self._images) == 1:
             raise self._bad[0]

@@ -343,6 +343,11 @@ class RJMCMCFilter:
         hists = None
         if candidate_hists is not None:
             hists = np.ascontiguousarray(real_array(candidate_hists, f"{fn}: candidate_hists"))
+            if hists.ndim != 2:  # was pybind11's list of step()'s signatures (a 3-D array)
+                raise ValueError(
+                    f"{fn}: candidate_hists must have shape (K, B), one row of "
+                    f"{binned.n_bins} bins per candidate, got {hists.shape}"
+                )
             bad = ~(np.isfinite(hists) & (hists >= 0))
             if bad.any():
                 k, at = first_at(bad)
@@ -409,6 +414,8 @@ class RJMCMCFilter:
             Another thread is inside this filter.
         """
         a = np.ascontiguousarray(real_array(affine, "RJMCMCFilter.warp: affine"))
+        if a.shape != (2, 3):  # was pybind11's list of warp()'s signatures (a 3-D array)
+            raise ValueError(f"RJMCMCFilter.warp: affine must have shape (2, 3), got {a.shape}")
         if not self._busy.acquire(blocking=False):
             raise _in_use(self, "RJMCMCFilter.warp")
         try:

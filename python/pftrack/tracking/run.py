@@ -137,7 +137,17 @@ def load_detections(path: PathLike, scale: float = 1.0) -> dict[int, F64]:
     return _Scaled(
         {f: np.column_stack([r[:, 2:6] * scale, r[:, 6]]) for f, r in group_by_frame(rows).items()},
         float(scale),
+        stated=not isinstance(scale, SeqinfoScale),
     )
+
+
+class SeqinfoScale(float):
+    """A detection scale taken from ``seqinfo.ini`` (the frames' width over ``imWidth``).
+
+    What ``pftrack track`` and ``batch`` pass to :func:`load_detections` when no
+    ``--det-scale`` is given, so that the dict knows its scale was not stated
+    (:attr:`_Scaled.stated`).
+    """
 
 
 class _Scaled(dict[int, F64]):
@@ -145,12 +155,15 @@ class _Scaled(dict[int, F64]):
 
     For the scale a refusal suggests (:func:`_scale_hint`): the file's boxes need the whole
     factor, not a factor on top of ``--det-scale`` (``--det-scale 2`` on PETS09 suggested
-    0.313, where 0.625 is right).
+    0.313, where 0.625 is right). `stated`: the scale was given (``--det-scale``,
+    ``load_detections(scale=...)``), not taken from ``seqinfo.ini`` (:class:`SeqinfoScale`);
+    :func:`_refuse_scaled_off`'s edge rule doubts only the latter.
     """
 
-    def __init__(self, frames: dict[int, F64], scale: float) -> None:
+    def __init__(self, frames: dict[int, F64], scale: float, stated: bool = True) -> None:
         super().__init__(frames)
-        self.scale = scale
+        self.scale = float(scale)
+        self.stated = stated
 
 
 def track_frames(
@@ -579,7 +592,9 @@ def _check_detections(detections: object, what: str = "detections") -> dict[int,
             r, _, problem = bad
             raise ValueError(f"{name} row {r} {d[r, :4].tolist()}: {problem} (left, top, w, h)")
         checked[f] = d
-    return _Scaled(checked, detections.scale) if isinstance(detections, _Scaled) else checked
+    if isinstance(detections, _Scaled):
+        return _Scaled(checked, detections.scale, detections.stated)
+    return checked
 
 
 def _check_last_frame(detections: dict[int, F64], n_frames: int) -> None:
@@ -695,7 +710,12 @@ def _refuse_scaled_off(
     not its images' (trial60cli: ``imWidth=1280`` beside 640x480 images tracked the boxes
     shrunk into the top-left corner, exit 0, with a warning to scale them; ``imWidth=320`` was
     refused as "in a larger frame's pixels? ... about 1 here", the scale 2 applied unsaid).
-    `outside` and `as_xyxy` are :func:`_check_layout`'s, one per box.
+    Also refused, when the scale is ``seqinfo.ini``'s and was not stated (:class:`SeqinfoScale`)
+    and at most :data:`EDGE_MAX_SCALE`: boxes that as given reach the frames' right and bottom
+    edges (:func:`_at_edges`). A ``--det-scale`` or ``load_detections(scale=...)`` of that value
+    is the user's word that the boxes are in ``seqinfo.ini``'s pixels, and is taken (was
+    refused like the automatic scale). `outside` and `as_xyxy` are :func:`_check_layout`'s,
+    one per box.
     """
     applied = float(getattr(detections, "scale", 1.0))
     n = len(outside)
@@ -719,6 +739,7 @@ def _refuse_scaled_off(
         which = f"{outside.sum()} of {n} detection boxes"
     elif (
         seqinfo is not None
+        and not getattr(detections, "stated", True)  # a scale the user states is theirs
         and applied <= EDGE_MAX_SCALE
         and _at_edges(right / applied, bottom / applied, cols, rows, applied)
     ):
