@@ -206,6 +206,26 @@ def test_the_adapters_warnings_name_the_callers_line(scene):
     assert {w.filename for w in caught} == {__file__}
 
 
+def test_update_is_the_trackers_packages_name_for_the_same_method(scene):
+    """A user trial: supervision 0.28 deprecated sv.ByteTrack for the ``trackers`` package's
+    ``ByteTrackTracker``, whose method is ``update(detections)``; ``SupervisionTracker.update``
+    was an AttributeError."""
+    a, b = SupervisionTracker(frame_rate=10.0), SupervisionTracker(frame_rate=10.0)
+    for n, frame in enumerate(scene.frames, start=1):
+        out_a = a.update(frame_detections(scene, n), frame)
+        out_b = b.update_with_detections(frame_detections(scene, n), frame)
+        np.testing.assert_array_equal(out_a.tracker_id, out_b.tracker_id)
+        np.testing.assert_array_equal(out_a.xyxy, out_b.xyxy)
+    np.testing.assert_array_equal(a.finalize(), b.finalize())
+    # its warnings name the caller's line too, and the frame is needed (pftrack follows colour)
+    detections = sv.Detections(xyxy=np.array([[-10.0, 30, 40, 90]]), confidence=np.array([5.0]))
+    with pytest.warns(UserWarning) as caught:
+        SupervisionTracker().update(detections, scene.frames[0])
+    assert caught and {w.filename for w in caught} == {__file__}
+    with pytest.raises(TypeError, match="frame"):
+        SupervisionTracker().update(detections)
+
+
 def test_the_adapters_no_track_warning_names_the_callers_line(scene):
     """A trial find: ``finalize``'s "no track" warning named the adapter's own line
     (pftrack/integrations/supervision.py), as update's warnings once did."""

@@ -1,4 +1,4 @@
-"""pftrack behind supervision's tracker interface (``update_with_detections``).
+"""pftrack behind supervision's tracker interface (``update_with_detections``, or ``update``).
 
 supervision is imported lazily, when a tracker is first updated; install it with
 ``pip install "pftrack[supervision]"``. Current supervision (0.31, what that extra installs today)
@@ -140,6 +140,10 @@ class SupervisionTracker:
     ) -> sv.Detections:
         """Track one frame's detections; return those that belong to a track, with its id.
 
+        Also ``update(detections, frame)``, the name of the ``trackers`` package's trackers
+        (``trackers.ByteTrackTracker().update(detections)``, which replaced supervision's
+        ByteTrack in supervision 0.28).
+
         Parameters
         ----------
         detections : supervision.Detections
@@ -192,6 +196,12 @@ class SupervisionTracker:
         out.tracker_id = tracks[:, 4].astype(int)
         result: sv.Detections = out
         return result
+
+    #: :meth:`update_with_detections` under the name the ``trackers`` package gives it:
+    #: supervision 0.28 deprecated its ByteTrack for ``trackers.ByteTrackTracker``, whose
+    #: ``update(detections)`` is ``update_with_detections`` renamed (removed in 0.30). The same
+    #: method: pftrack's takes the frame too, ``update(detections, frame)``.
+    update = update_with_detections
 
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
         """Start the background behind box refinement from `frames` (:meth:`pftrack.Tracker.prime`).
