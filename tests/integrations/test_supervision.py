@@ -206,6 +206,41 @@ def test_the_adapters_warnings_name_the_callers_line(scene):
     assert {w.filename for w in caught} == {__file__}
 
 
+def test_update_returns_every_detection_as_the_trackers_package_does(scene):
+    """A user trial: supervision 0.28 deprecated sv.ByteTrack for the ``trackers`` package's
+    ``ByteTrackTracker``, whose ``update(detections, frame=None)`` returns every detection,
+    tracker_id -1 on the untracked ones; ``SupervisionTracker.update`` was an AttributeError."""
+    a, b = SupervisionTracker(frame_rate=10.0), SupervisionTracker(frame_rate=10.0)
+    untracked = 0
+    for n, frame in enumerate(scene.frames, start=1):
+        dets = frame_detections(scene, n)
+        everything = a.update(dets, frame)
+        tracked = b.update_with_detections(dets, frame)
+        assert len(everything) >= len(dets)  # each once, a blob's once per track
+        minus = everything[everything.tracker_id == -1]  # as given (truth ids: one row each)
+        given = {t: tuple(x) for t, x in zip(dets.data["truth_id"], dets.xyxy, strict=True)}
+        pairs = zip(minus.data["truth_id"], minus.xyxy, strict=True)
+        assert all(given[t] == tuple(x) for t, x in pairs)
+        kept = everything[everything.tracker_id != -1]
+        np.testing.assert_array_equal(kept.tracker_id, tracked.tracker_id)
+        np.testing.assert_array_equal(kept.xyxy, tracked.xyxy)
+        np.testing.assert_array_equal(kept.data["truth_id"], tracked.data["truth_id"])
+        # the input's order: the truth ids of the rows back, as given
+        assert list(dict.fromkeys(everything.data["truth_id"])) == list(dets.data["truth_id"])
+        untracked += int((everything.tracker_id == -1).sum())
+    assert untracked > 0  # the first frames' tracks are not yet confirmed
+    np.testing.assert_array_equal(a.finalize(), b.finalize())
+    # its warnings name the caller's line too, and the frame is needed (pftrack follows colour)
+    detections = sv.Detections(xyxy=np.array([[-10.0, 30, 40, 90]]), confidence=np.array([5.0]))
+    with pytest.warns(UserWarning) as caught:
+        SupervisionTracker().update(detections, scene.frames[0])
+    assert caught and {w.filename for w in caught} == {__file__}
+    with pytest.raises(TypeError, match="frame"):
+        SupervisionTracker().update(detections)
+    empty = SupervisionTracker().update(sv.Detections.empty(), scene.frames[0])
+    assert len(empty) == 0 and empty.tracker_id is not None
+
+
 def test_the_adapters_no_track_warning_names_the_callers_line(scene):
     """A trial find: ``finalize``'s "no track" warning named the adapter's own line
     (pftrack/integrations/supervision.py), as update's warnings once did."""

@@ -410,6 +410,41 @@ def test_values_read_are_written_unchanged_and_writing_is_a_fixed_point(tmp_path
     assert all(len(f.partition(".")[2]) <= 2 for f in fields)
 
 
+def test_float32_values_are_written_as_their_float32_digits(tmp_path: Path) -> None:
+    """Regression: a detector's float32 score put in a float64 array (supervision's
+    ``confidence``, a BoxMOT loop's ``dets``, rows stacked from them) has 16 digits as a double
+    and was rounded to 2 decimals (0.9955 -> 1, 0.004 -> 0), so ``Tracker.finalize()`` fed the
+    float32 boxes of a det.txt wrote other scores than ``pftrack track`` on that det.txt."""
+    single = np.array(
+        [
+            [1, 1, 649.44, 231.5, 44.42, 86.13, 0.9955, -1, -1, -1],
+            [1, 2, 649.4412, 0.1, 3.0000002, 7, 0.004, 0.997784, 123456789, -1],
+        ],
+        np.float32,
+    )
+    q = tmp_path / "out.txt"
+    mot.write_mot(q, single.astype(np.float64))
+    assert q.read_text().splitlines() == [
+        "1,1,649.44,231.5,44.42,86.13,0.9955,-1,-1,-1",
+        "1,2,649.4412,0.1,3.0000002,7,0.004,0.997784,123456792,-1",  # the float32 integer
+    ]
+    back = mot.read_mot(q)
+    np.testing.assert_array_equal(back.astype(np.float32), single)  # the same float32s
+    first = q.read_bytes()
+    mot.write_mot(q, back)
+    assert q.read_bytes() == first  # a fixed point
+    assert mot.mot_text(single) == first.decode()  # a float32 array itself too
+    # a float32 too small for its digits within 22 decimals is rounded as before
+    assert mot.mot_text(np.array([[1, 1, 1, 2, 3, 4, np.float32(1e-30), -1]])).startswith(
+        "1,1,1,2,3,4,0,-1,"
+    )
+    # doubles that are no float32 (pftrack's computed boxes) keep their 2 decimals
+    rng = np.random.default_rng(2)
+    a = np.column_stack([np.arange(1, 501), np.ones(500), np.abs(rng.normal(0, 300, (500, 8)))])
+    fields = mot.mot_text(a).replace("\n", ",").split(",")
+    assert all(len(f.partition(".")[2]) <= 2 for f in fields)
+
+
 def test_huge_values_are_written_short_and_read_back_equal(tmp_path: Path) -> None:
     """Was: a conf of 1e308 written as a 309-digit integer (``%.0f``)."""
     a = np.array(

@@ -61,8 +61,12 @@ SEQUENCES = {
 
 
 @pytest.mark.dataset
-@pytest.mark.parametrize("name", sorted(SEQUENCES))
-def test_documented_loop_is_the_cli_byte_for_byte(name, tmp_path):
+@pytest.mark.parametrize(
+    ("name", "dtype"),
+    [*((name, np.float64) for name in sorted(SEQUENCES)), ("tud-campus", np.float32)],
+)
+def test_documented_loop_is_the_cli_byte_for_byte(name, dtype, tmp_path):
+    """float32: a detector's usual dtype; its scores were written rounded to 2 decimals."""
     folder = dataset(name)
     video, scale = SEQUENCES[name]
     cli_out = tmp_path / "cli.txt"
@@ -79,6 +83,7 @@ def test_documented_loop_is_the_cli_byte_for_byte(name, tmp_path):
         dets = np.column_stack([r[:, 2:4] * scale, (r[:, 2:4] + r[:, 4:6]) * scale, r[:, 6]])
         # x2 as the CLI computes it, from the scaled left and width: same floats, same bytes
         dets[:, 2:4] = r[:, 2:4] * scale + r[:, 4:6] * scale
+        dets = dets.astype(dtype)
         tracks = tracker.update(dets, frame)
         assert tracks.shape[1] == 8 and tracks.dtype == np.float64
         ids = tracks[:, 4]

@@ -1,4 +1,4 @@
-"""pftrack behind supervision's tracker interface (``update_with_detections``).
+"""pftrack behind supervision's tracker interface (``update_with_detections``; ``update``).
 
 supervision is imported lazily, when a tracker is first updated; install it with
 ``pip install "pftrack[supervision]"``. Current supervision (0.31, what that extra installs today)
@@ -140,6 +140,10 @@ class SupervisionTracker:
     ) -> sv.Detections:
         """Track one frame's detections; return those that belong to a track, with its id.
 
+        :meth:`update` returns every detection, -1 on the untracked ones, as the ``trackers``
+        package's trackers do (``trackers.ByteTrackTracker``, which replaced supervision's
+        ByteTrack in supervision 0.28).
+
         Parameters
         ----------
         detections : supervision.Detections
@@ -168,6 +172,45 @@ class SupervisionTracker:
             NaN or inf in ``xyxy`` or ``confidence``, a ``class_id`` that is not an integer
             (each named by its field and row), or what :meth:`pftrack.Tracker.update` refuses.
         """
+        return self._track(detections, frame, every=False)
+
+    def update(self, detections: sv.Detections, frame: NDArray[np.uint8]) -> sv.Detections:
+        """Track one frame's detections as the ``trackers`` package's trackers do: return all.
+
+        supervision 0.28 deprecated its ByteTrack for ``trackers.ByteTrackTracker``, whose
+        ``update(detections, frame=None)`` returns every detection, ``tracker_id`` -1 on those
+        no track follows; this is that method (pftrack needs the frame: it follows colour).
+        :meth:`update_with_detections` returns the tracked ones only, as supervision's
+        ByteTrack did.
+
+        Parameters
+        ----------
+        detections : supervision.Detections
+            This frame's detections (``xyxy``; ``confidence`` and ``class_id`` when present).
+        frame : (H, W, 3) ndarray of uint8
+            The BGR frame.
+
+        Returns
+        -------
+        supervision.Detections
+            Every detection, in the input's order, with ``tracker_id`` set: the id of the
+            confirmed track matched to it this frame, else -1 (a detection that started no
+            track, or whose track is not yet confirmed). A detection that tracks share (a blob
+            of people who merged) comes once per track, with that track's box, as in
+            :meth:`update_with_detections` (whose rows are those with an id here); filters'
+            boxes are not clipped to the frame.
+
+        Raises
+        ------
+        TypeError, ValueError
+            As :meth:`update_with_detections`.
+        """
+        return self._track(detections, frame, every=True)
+
+    def _track(
+        self, detections: sv.Detections, frame: NDArray[np.uint8], every: bool
+    ) -> sv.Detections:
+        """:meth:`update_with_detections` (`every` False) or :meth:`update` (`every` True)."""
         detections_cls = _detections_class()
         if not isinstance(detections, detections_cls):
             raise TypeError(
@@ -180,16 +223,29 @@ class SupervisionTracker:
             np.ones(n) if conf is None else _field(conf, "confidence", (n, 1)),
             np.zeros(n) if cls is None else _field(cls, "class_id", (n, 1)),
         ])  # fmt: skip
-        tracks = self.tracker.update(dets, frame)
+        self.tracker._caller_depth = 2  # warnings name the user's line: past a method and this
+        try:
+            tracks = self.tracker.update(dets, frame)
+        finally:
+            self.tracker._caller_depth = 1  # finalize's and prime's: one method
         # the input's order, as ByteTrack keeps it (a blob's tracks in track order)
         tracks = tracks[np.argsort(tracks[:, 7], kind="stable")]
         rows = tracks[:, 7].astype(np.int64)
-        out = detections[rows]
+        ids = tracks[:, 4].astype(int)
+        boxes = tracks[:, :4]
         shared = np.bincount(rows, minlength=n)[rows] > 1 if len(rows) else np.zeros(0, bool)
+        if every:  # the detections no confirmed track follows too, tracker_id -1, in order
+            rest = np.setdiff1d(np.arange(n), rows)
+            order = np.argsort(np.concatenate([rows, rest]), kind="stable")
+            rows = np.concatenate([rows, rest])[order]
+            ids = np.concatenate([ids, np.full(len(rest), -1)])[order]
+            shared = np.concatenate([shared, np.zeros(len(rest), bool)])[order]
+            boxes = np.concatenate([boxes, np.zeros((len(rest), 4))])[order]
+        out = detections[rows]
         if shared.any():  # each track its own box, in the input's dtype
             out.xyxy = np.array(out.xyxy, copy=True)
-            out.xyxy[shared] = tracks[shared, :4].astype(out.xyxy.dtype)
-        out.tracker_id = tracks[:, 4].astype(int)
+            out.xyxy[shared] = boxes[shared].astype(out.xyxy.dtype)
+        out.tracker_id = ids
         result: sv.Detections = out
         return result
 

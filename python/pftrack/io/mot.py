@@ -437,16 +437,53 @@ def _decimals(v: F64, limit: float, most: int) -> NDArray[np.int64]:
 _REPR = 31
 
 
+def _single_digits(v: F64) -> tuple[F64, NDArray[np.int64]]:
+    """Each of `v` that is exactly a float32 as its shortest decimal, and its decimals.
+
+    The decimal is the one with the fewest decimals that reads back as that float32; the
+    decimals are -1 for the others (left as they are).
+
+    A detector's or tracker's float32 score or box put in a float64 array (``0.9955`` as
+    float32 is ``0.9955000281333923``) is then written ``0.9955``, the value the float32
+    holds (its shortest form has at most 9 significant digits), not rounded to 2 decimals
+    as a computed double is (``1``). A value pftrack computes in float64 lands on a float32
+    about once in 2**29. The decimal is the nearest one at each number of decimals in turn,
+    kept at the first that reads back as the float32 (at most :data:`MOST_DECIMALS`; a float32
+    below that, 1e-30, is left to the rounding).
+    """
+    with np.errstate(over="ignore"):  # beyond float32's range: inf, never equal to v
+        single = v.astype(np.float32)
+    todo = np.flatnonzero(single.astype(np.float64) == v)
+    dec = np.full(len(v), -1, np.int64)
+    if not len(todo):  # pftrack's own rows: no copy
+        return v, dec
+    out = v.copy()
+    for k in range(MOST_DECIMALS + 1):
+        if not len(todo):
+            break
+        scale = 10.0**k
+        n = np.rint(v[todo] * scale)
+        r = n / scale  # the double nearest n / 10**k: both exact, the division correctly rounded
+        ok = (np.abs(n) < 10.0**EXACT_DIGITS) & (r.astype(np.float32) == single[todo])
+        out[todo[ok]] = r[ok]
+        dec[todo[ok]] = _decimals(r[ok], 10.0**EXACT_DIGITS, MOST_DECIMALS)
+        todo = todo[~ok]
+    out[dec < 0] = v[dec < 0]
+    return out, dec
+
+
 def _printable(a: F64, exact: NDArray[np.bool_] | None) -> tuple[F64, NDArray[np.int64]]:
     """The values written for columns 3-10 of `a` (M, 10) and the decimals of each.
 
     A value with at most :data:`EXACT_DIGITS` significant digits is written exactly, with the
     fewest decimals (a value of 1e16 or more, always an integer, in its shortest round-trip
     form: ``1e+308``); so is any value `exact` (M, 10) marks, in its shortest round-trip form
-    (code :data:`_REPR`: ``%r``, the digits Python's ``repr`` gives) when it needs more; any
-    other is rounded to 2 decimals as ``%.2f`` rounds it, then written with the fewest
-    decimals that value needs. So a file read back writes the same text (``88.00`` is written
-    ``88`` the first time already) and the values a file held are written unchanged.
+    (code :data:`_REPR`: ``%r``, the digits Python's ``repr`` gives) when it needs more; a
+    value that is exactly a float32 (a detector's score), as the float32's digits
+    (:func:`_single_digits`: ``0.9955``); any other is rounded to 2 decimals as ``%.2f``
+    rounds it, then written with the fewest decimals that value needs. So a file read back
+    writes the same text (``88.00`` is written ``88`` the first time already) and the values a
+    file held are written unchanged.
     """
     v = np.array(a[:, 2:], dtype=np.float64).ravel()  # a copy of its own: changed in place
     d = _decimals(v, 10.0**EXACT_DIGITS, MOST_DECIMALS)
@@ -457,6 +494,9 @@ def _printable(a: F64, exact: NDArray[np.bool_] | None) -> tuple[F64, NDArray[np
     if exact is not None:
         d[exact[:, 2:].ravel() & (d < 0)] = _REPR
     rest = d < 0
+    if rest.any():  # a float32 in a double: the float32's digits (0.9955, not 1)
+        v[rest], d[rest] = _single_digits(v[rest])
+        rest = d < 0
     if rest.any():
         p = v[rest] * 100.0
         r = np.rint(p) / 100.0
@@ -568,8 +608,10 @@ def mot_text(rows: NDArray[np.float64] | Iterable[Iterable[float]], *, exact: Ex
 
     Frame and id as integers; every other value exactly when it has at most
     :data:`EXACT_DIGITS` significant digits (every value a file written with up to 10 digits
-    held), else rounded to 2 decimals (values pftrack computed); with the fewest decimals
-    either way (``88``, ``0.99502``, ``12.35``). So the text of what :func:`read_mot` reads of
+    held), else rounded to 2 decimals (values pftrack computed), but for a value that is
+    exactly a float32 (a detector's score put in a float64 array), written as the float32's
+    digits (``0.9955``, at most 9 significant); with the fewest decimals either way (``88``,
+    ``0.99502``, ``12.35``). So the text of what :func:`read_mot` reads of
     it is the same. Missing columns get the defaults ``conf=1, x=y=z=-1``.
 
     Parameters
@@ -637,7 +679,9 @@ def write_mot(
     shortest form, and writing what :func:`read_mot` reads of a written file gives the same
     bytes. Longer values are rounded to 2 decimals (pftrack's computed boxes) unless marked
     by `exact` (as in :func:`mot_text`): ``write_mot(out, read_mot(f), exact=True)`` writes
-    every value of any file unchanged.
+    every value of any file unchanged. A value that is exactly a float32 (a detector's score
+    or box, float32 as detectors give them) is written as the float32's digits, ``0.9955``,
+    not rounded (at most 9 significant digits).
 
     Parameters
     ----------
