@@ -1,5 +1,6 @@
 """README.md and docs/*.md as a reader follows them: every relative link and #anchor lands, the
-set-up commands are the ones CI runs, and the README's Goals table stays a table of short cells.
+set-up commands are the ones CI runs, every ``pftrack`` command of the README's bash blocks is
+one the parser takes with its options spelt in full, and the Goals table keeps short cells.
 
 The README's Python blocks are run by tests/test_api.py and tests/tracking/test_api_tracker.py.
 """
@@ -7,10 +8,13 @@ The README's Python blocks are run by tests/test_api.py and tests/tracking/test_
 from __future__ import annotations
 
 import re
+import shlex
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+
+from pftrack.cli import build_parser
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
@@ -131,3 +135,41 @@ def test_goals_is_one_short_row_per_goal() -> None:
         cells = [c.strip() for c in row.strip("|").split("|")]
         assert len(cells) == 4 and cells[3], row
         assert len(cells[2]) <= 450, f"a Goals cell of {len(cells[2])} characters: {cells[2]}"
+
+
+def _readme_pftrack_commands() -> list[list[str]]:
+    """Every ``pftrack ...`` command of the README's bash blocks, as argv after ``pftrack``."""
+    commands = []
+    for block in _bash_blocks(README.read_text(encoding="utf-8")):
+        for line in block.replace("\\\n", " ").splitlines():
+            for part in re.split(r"\s(?:;|&&)\s", line):
+                argv = shlex.split(part, comments=True)
+                if argv[:1] == ["pftrack"]:
+                    commands.append(argv[1:])
+    return commands
+
+
+def test_the_readme_runs_pftrack_commands() -> None:
+    commands = _readme_pftrack_commands()
+    assert {c[0] for c in commands if c} >= {"demo", "track", "eval", "smooth", "recover",
+                                             "render", "batch", "experiment"}  # fmt: skip
+
+
+@pytest.mark.parametrize("argv", _readme_pftrack_commands(), ids=" ".join)
+def test_every_readme_pftrack_command_parses(
+    argv: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Each command the README shows is one the parser takes: its subcommand, options and
+    values exist (``--help`` prints and exits 0). Nothing runs: the files are the reader's."""
+    parser = build_parser()
+    if "--help" in argv:
+        with pytest.raises(SystemExit) as exc:
+            parser.parse_args(argv)
+        assert exc.value.code == 0 and "usage: pftrack" in capsys.readouterr().out
+        return
+    assert parser.parse_args(argv) is not None
+    with pytest.raises(SystemExit):  # spelt in full, not an abbreviation argparse would take
+        parser.parse_args([*argv, "--help"])  # the (sub)command's own --help
+    usage = capsys.readouterr().out
+    for option in (a.split("=")[0] for a in argv if a.startswith("--")):
+        assert re.search(rf"{option}\b(?!-)", usage), f"{option} is not spelt as in --help"
