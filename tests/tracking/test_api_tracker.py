@@ -551,6 +551,60 @@ def test_detections_in_a_larger_frames_pixels_are_refused(scene):
     assert run.n_frames == 10
 
 
+def test_loop_refuses_boxes_in_a_larger_frames_pixels(scene):
+    """Was a warning that boxes were clipped (wrong coordinate scale?), and tracks of the
+    clipped boxes, while track_frames refused the same boxes: the loop refuses them once 20
+    boxes have been given and more than 10 % of them lay wholly outside the frame."""
+    d = scene_dets(scene)
+    large = [np.column_stack([v[:, :4] * 2.0, v[:, 4:]]) for v in d]
+    tracker = pftrack.Tracker(seed=0, prime=0)
+    message = (
+        r"^dets: \d+ of the \d+ boxes given so far lie wholly outside the 480x360 frame \(they "
+        r"reach \d+x\d+\): are they in a larger frame's pixels\? Multiply x1, y1, x2, y2 by the "
+        r"frame's size over theirs: at most 0\.5\d* by their reach so far \(e\.g\. 0\.5 for "
+        r"960x720, 0\.333 for 1440x1080, 0\.25 for 1920x1440 pixels\)$"
+    )
+    with pytest.warns(UserWarning, match="clipped"), pytest.raises(ValueError, match=message):
+        for k, frame in enumerate(scene.frames):
+            tracker.update(large[k], frame)
+    assert 0 < tracker.frame_count < 20  # within the first frames, at the 20th box or so
+    given = sum(len(v) for v in large[: tracker.frame_count + 1])
+    assert given >= 20 and sum(len(v) for v in large[: tracker.frame_count]) < given
+    n = tracker.frame_count
+    with pytest.raises(ValueError, match="wholly outside"):  # the refused frame changed nothing
+        tracker.update(large[n], scene.frames[n])
+    assert tracker.frame_count == n
+    # the boxes at the frame's scale, and a few past its edge (stray boxes), run on
+    few = [v.copy() for v in d]
+    for v in [v for v in few if len(v)][9::10]:
+        v[0, [0, 2]] = [490.0, 520.0]
+    with pytest.warns(UserWarning, match="clipped"):
+        run_loop(pftrack.Tracker(seed=0, prime=0), scene.frames, few)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        run_loop(pftrack.Tracker(seed=0, prime=0), scene.frames, d)
+
+
+@pytest.mark.dataset
+def test_loop_refuses_pets09_det_txt_unscaled():
+    """A user trial: PETS09's det.txt as given (768x576 pixels) on its 480x360 video ran 60
+    frames with one warning and 117 wrong rows; the scaled boxes run the whole video
+    (test_documented_loop_is_the_cli_byte_for_byte)."""
+    folder = dataset("pets09-s2l1")
+    by_frame = group_by_frame(read_mot(folder / "det.txt"))
+    tracker = pftrack.Tracker(frame_rate=7.0)
+    message = (
+        r"^dets: 13 of the 21 boxes given so far lie wholly outside the 480x360 frame .* at "
+        r"most 0\.692 by their reach so far \(e\.g\. 0\.667 for 720x540, 0\.625 for 768x576, "
+        r"0\.5 for 960x720 pixels\)$"
+    )
+    with pytest.warns(UserWarning, match="clipped"), pytest.raises(ValueError, match=message):
+        for n, frame in enumerate(itertools.islice(FrameSource(folder / "video.avi"), 60), 1):
+            r = by_frame.get(n, np.zeros((0, 10)))
+            tracker.update(xywh_to_xyxy_dets(r[:, [2, 3, 4, 5, 6]]), frame)
+    assert tracker.frame_count == 6  # refused at frame 7
+
+
 def test_boxes_outside_the_frame_are_clipped_once(scene):
     frame = scene.frames[0]
     h, w = frame.shape[:2]
@@ -1073,6 +1127,8 @@ def test_no_track_warning_says_what_the_detections_were(scene, where, hint):
     flat = np.array([[w, 10.0, w, 50.0, 0.9], [30.0, 40.0, 60.0, 40.0, 0.9]])
     box = {"no box": np.zeros((0, 5)), "outside": far, "tiny": tiny, "flat": flat}[where]
     dets = [box] * len(scene.frames)
+    if where == "outside":  # under 20 boxes: more are refused (a larger frame's pixels?)
+        dets = [box] * 19 + [np.zeros((0, 5))] * (len(scene.frames) - 19)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         _, rows = run_loop(pftrack.Tracker(seed=0), scene.frames, dets)

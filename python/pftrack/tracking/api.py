@@ -335,6 +335,60 @@ def check_boxes_xyxy(
     return CheckedBoxes(xywh, cls, kept, clipped, n_flat, n_inverted, len(d) - n_flat)
 
 
+def _outside_the_frame(
+    dets: ArrayLike, shape: tuple[int, int], seen: tuple[int, float, float]
+) -> tuple[int, float, float]:
+    """`seen` plus `dets`'s boxes wholly past the frame's right or bottom edge; furthest x2, y2.
+
+    `dets`: boxes :func:`check_boxes_xyxy` took (x1, y1, x2, y2 first); only those with an
+    extent count, as in its `extent`. The evidence of boxes in a larger frame's pixels over a
+    run (:meth:`Tracker.update`; :func:`_refuse_larger_frame`).
+    """
+    d = np.asarray(dets, dtype=np.float64)[:, :4]  # checked: (N, 4), (N, 5) or (N, 6)
+    d = d[(d[:, 2] > d[:, 0]) & (d[:, 3] > d[:, 1])]
+    if len(d) == 0:
+        return seen
+    rows, cols = shape
+    past = int(((d[:, 0] >= cols) | (d[:, 1] >= rows)).sum())
+    return seen[0] + past, max(seen[1], float(d[:, 2].max())), max(seen[2], float(d[:, 3].max()))
+
+
+def _refuse_larger_frame(
+    outside: tuple[int, float, float], extent: int, shape: tuple[int, int], name: str
+) -> None:
+    """Refuse a run's boxes in a larger frame's pixels: ValueError naming the scale.
+
+    `outside`: :func:`_outside_the_frame`'s count and reach over the run's boxes so far,
+    `extent` of them with an extent. The rule of ``pftrack track`` and :func:`track_frames`
+    (``_check_layout``), decided on the boxes given so far: at least ``SMALL_LAYOUT_BOXES``
+    (20), more than ``OUTSIDE_SHARE`` (10 %) of them wholly outside the frame. None of the
+    five det.txt files here at their scale (PETS09's times 0.625, TUD-Campus, ADL-Rundle-6,
+    ETH-Sunnyday, KITTI-17), nor their gt.txt files, has a box wholly outside at any point of
+    the run; PETS09's det.txt unscaled on its 480x360 video has 65 % of its first boxes so and
+    is refused at frame 7 (its 21st box). Was: a warning that boxes were clipped (wrong
+    coordinate scale?), and tracks of the clipped boxes. The scale is not named as the
+    command names it (``_scale_hint``, from the whole file's reach): the first frames' boxes
+    seldom reach the far edges (PETS09's first 7 frames reach 694x328 of 768x576, 0.692 where
+    the scale is 0.625), so their reach gives an upper bound, said as one, and the round
+    ratios below it with the sizes they mean.
+    """
+    from pftrack.tracking.run import OUTSIDE_SHARE, ROUND_RATIOS, SMALL_LAYOUT_BOXES  # a cycle
+
+    n_out, right, bottom = outside
+    if extent < SMALL_LAYOUT_BOXES or n_out <= OUTSIDE_SHARE * extent:
+        return
+    rows, cols = shape
+    bound = min(cols / right, rows / bottom)  # < 1: a box starts past an edge
+    ratios = sorted((k for k in ROUND_RATIOS if k <= bound), reverse=True)[:3]
+    sizes = ", ".join(f"{k:.3g} for {cols / k:.0f}x{rows / k:.0f}" for k in ratios)
+    raise ValueError(
+        f"{name}: {n_out} of the {extent} boxes given so far lie wholly outside the "
+        f"{cols}x{rows} frame (they reach {right:.0f}x{bottom:.0f}): are they in a larger "
+        "frame's pixels? Multiply x1, y1, x2, y2 by the frame's size over theirs: at most "
+        f"{bound:.3g} by their reach so far{f' (e.g. {sizes} pixels)' if sizes else ''}"
+    )
+
+
 def _moves(moves: object) -> tuple[float, float, float, float]:
     """``Tracker``'s `moves`: 4 real numbers (birth, death, update, swap) the chain can use.
 
@@ -603,6 +657,10 @@ class Tracker:
     #: the evidence of x, y, w, h rows (:func:`check_boxes_xyxy`). A class default for a
     #: checkpoint pickled before it was kept.
     _layout: tuple[int, int] = (0, 0)
+    #: Boxes wholly past the frame's right or bottom edge and the furthest x2, y2 the run was
+    #: given: the evidence of a larger frame's pixels (:func:`_outside_the_frame`). A class
+    #: default for a checkpoint pickled before it was kept.
+    _outside: tuple[int, float, float] = (0, 0.0, 0.0)
     #: Stand-ins among the run's frames taken (:mod:`pftrack._stand_in`; a class default for
     #: a checkpoint pickled before they were counted).
     _stood = 0
@@ -927,6 +985,7 @@ class Tracker:
             # foot row, height, class, frame of the given boxes, working pixels (drop_odd_sizes)
             self._sizes: list[F64] = []
             self._layout = (0, 0)  # inverted boxes, boxes with an extent (check_boxes_xyxy)
+            self._outside = (0, 0.0, 0.0)  # boxes wholly outside, reach (_outside_the_frame)
             # working / frame pixels as (x, y, x, y), the factors of a left, top, w, h box; set
             # with the run's first frame (None: tracked at the frame's own size)
             self._scale: F64 | None = None
@@ -1341,6 +1400,15 @@ class Tracker:
                 dets, (f.shape[0], f.shape[1]), name=self._box_source,
                 xywh_hint=self._box_source == "dets", seen=self._layout,
             )  # fmt: skip
+            # boxes in a larger frame's pixels, refused once the run's boxes say so
+            outside = self._outside
+            if clipped:
+                outside = _outside_the_frame(dets, (f.shape[0], f.shape[1]), outside)
+            if outside[0]:
+                extent_seen = self._layout[1] + extent
+                _refuse_larger_frame(
+                    outside, extent_seen, (f.shape[0], f.shape[1]), self._box_source
+                )
             if flat:
                 self._warn_once(
                     "empty",
@@ -1412,6 +1480,7 @@ class Tracker:
                 foot, at = box[:, 1] + box[:, 3], np.full(len(box), float(self.frame_count))
                 self._sizes.append(np.column_stack([foot, box[:, 3], c, at]))
             self._layout = (self._layout[0] + inverted, self._layout[1] + extent)
+            self._outside = outside
             self._max_conf = max(self._max_conf, confidence)
         self.frame_count += 1
         self._stood += stand_in
