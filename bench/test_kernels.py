@@ -267,6 +267,21 @@ def test_resample_filterpy(benchmark: BenchmarkFixture, weights_10k: F64) -> Non
     _compare(benchmark, "filterpy")
 
 
+@pytest.mark.benchmark(group="normals N=6000")
+def test_normals_core(benchmark: BenchmarkFixture) -> None:
+    # sis_step's propagation noise of 10 objects x 200 particles x 3 (rng.hpp's Box-Muller)
+    z = benchmark(_core.counter_normals, 3, 17, 6000)
+    assert z.shape == (6000,)
+    _compare(benchmark, "core")
+
+
+@pytest.mark.benchmark(group="normals N=6000")
+def test_normals_numpy(benchmark: BenchmarkFixture) -> None:
+    gen = np.random.default_rng(3)
+    benchmark(gen.standard_normal, 6000)
+    _compare(benchmark, "numpy", check=False)
+
+
 @pytest.fixture(scope="module")
 def uniforms_10k() -> F64:
     return np.random.default_rng(5).random(10_000)
