@@ -263,8 +263,7 @@ def run(args: argparse.Namespace) -> int:
     stdout once every output is written: a closed stdout (``| head``) then costs the summary,
     never the files.
     """
-    import numpy as np
-
+    from pftrack._stats import unique_values
     from pftrack.cli._options import opencv_single_threaded
     from pftrack.cli._signals import hold_interrupts, set_outcome
     from pftrack.io.atomic import (
@@ -366,7 +365,7 @@ def run(args: argparse.Namespace) -> int:
                     )
                 if not streamed:
                     write_mot(stage(args.out), result.rows)
-                n_ids = len(np.unique(result.rows[:, 1])) if len(result.rows) else 0
+                n_ids = len(unique_values(result.rows[:, 1])) if len(result.rows) else 0
                 n_rows = len(result.rows)
                 if streamed:  # what went there: the finished tracks are not written
                     n_ids, n_rows = len(online_ids), n_online[0]
