@@ -5,11 +5,13 @@ from __future__ import annotations
 import math
 import subprocess
 import sys
+import types
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from pftrack._check import refuse_masked
 from pftrack._stats import median, median_along, percentile, unique_values
 from pftrack.synthetic import make_scene
 
@@ -94,3 +96,18 @@ def test_a_track_run_never_imports_numpy_ma(tmp_path: Path) -> None:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split()[-2:] == ["0", "False"], out.stderr
     assert (tmp_path / "t.txt").stat().st_size > 0
+
+
+def test_the_masked_check_passes_while_another_thread_imports_numpy_ma(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``refuse_masked`` reads ``sys.modules["numpy.ma"]``, which exists without its names
+    while another thread imports it (now late in a run: this module's functions no longer
+    import it early). Was an AttributeError (``partially initialized module 'numpy.ma' has no
+    attribute 'MaskedArray'``) on ``pftrack track --render``'s drawing thread after a Ctrl-C."""
+    monkeypatch.setitem(sys.modules, "numpy.ma", types.ModuleType("numpy.ma"))
+    refuse_masked(np.zeros((2, 3)), "rows")  # no error: nothing masked can exist yet
+    monkeypatch.undo()
+    masked = np.ma.masked_array([1.0, 2.0], mask=[True, False])
+    with pytest.raises(TypeError, match="rows is a numpy.ma.MaskedArray with 1 masked value"):
+        refuse_masked(masked, "rows")
