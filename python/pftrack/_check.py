@@ -196,7 +196,16 @@ def refuse_masked(
     # a MaskedArray exists only once numpy.ma is imported: ``np.ma`` would import it (10-25
     # ms of every command's start-up, for a check that a tracking run makes at import time)
     ma = sys.modules.get("numpy.ma")
-    if ma is not None and isinstance(values, ma.MaskedArray) and ma.is_masked(values):
+    # and while another thread imports it, the module is there without its names yet (no
+    # MaskedArray made by a caller can exist then): was an AttributeError on `track
+    # --render`'s drawing thread after a Ctrl-C, once runs stopped importing numpy.ma early
+    masked_array = getattr(ma, "MaskedArray", None)
+    if (
+        ma is not None
+        and masked_array is not None
+        and isinstance(values, masked_array)
+        and ma.is_masked(values)
+    ):
         n = int(np.count_nonzero(ma.getmaskarray(values)))
         raise TypeError(
             f"{what} is a numpy.ma.MaskedArray with {counted(n, 'masked value')}, whose mask "

@@ -21,6 +21,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._stats import median
+
 __all__ = ["BLOCKY", "BLOCK_FRAMES", "BLOCK_SIZE", "MIN_STEP", "blockiness", "is_blocky"]
 
 BLOCK_SIZE = 8
@@ -84,4 +86,4 @@ def blockiness(frame: NDArray[np.uint8]) -> float:
 
 def is_blocky(values: list[float]) -> bool:
     """Whether the median of `values` (:func:`blockiness` of frames) is :data:`BLOCKY` or more."""
-    return bool(values) and float(np.median(values)) >= BLOCKY
+    return bool(values) and median(values) >= BLOCKY

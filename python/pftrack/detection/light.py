@@ -34,6 +34,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._stats import median, percentile
+
 __all__ = [
     "BLANK_LEVELS",
     "DARK_LEVEL",
@@ -161,13 +163,13 @@ def looks_grey(frames: Iterable[NDArray[np.uint8]], tolerance: float = 3.0) -> b
     spreads = []
     for f in frames:  # a colour video is told from its first frame: the others are not read
         spreads.append(channel_spread(f))
-        if np.percentile(spreads[-1], 99) > tolerance:
+        if percentile(spreads[-1], 99) > tolerance:
             return False
     spread = np.concatenate(spreads)
     step = sample_step(frames[0].shape)
     level = np.concatenate([f[::step, ::step, 1].ravel() for f in frames])
     # a blank or flat picture (no video, a test pattern) tells nothing about colour
-    return bool(np.percentile(spread, 99) <= tolerance and level.std() >= MIN_CONTENT)
+    return bool(percentile(spread, 99) <= tolerance and level.std() >= MIN_CONTENT)
 
 
 def frame_gain(
@@ -202,7 +204,7 @@ def frame_gain(
     sr = _pixel_sums(reference[::step, ::step])
     si = _pixel_sums(frame[::step, ::step])
     keep = (sr >= min_sum) & (sr > 0)
-    return float(np.median(si[keep] / sr[keep])) if keep.any() else 1.0
+    return median(si[keep] / sr[keep]) if keep.any() else 1.0
 
 
 def _pixel_sums(image: NDArray[Any]) -> NDArray[np.float64]:

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from pftrack import _core
 from pftrack._check import integer, number
+from pftrack._stats import median
 
 __all__ = ["PersonSizeModel", "SizeModelConfig", "expected_size", "head_height", "theil_sen"]
 
@@ -318,7 +319,7 @@ class PersonSizeModel:
             return False
         held = self._samples[: self.n_samples]
         spread = (max(self._slopes) - min(self._slopes)) * float(np.ptp(held[:, 0]))
-        return spread <= (1.0 - share) * float(np.median(held[:, 1]))
+        return spread <= (1.0 - share) * median(held[:, 1])
 
     def split_count(self, boxes: NDArray[np.float64]) -> NDArray[np.int64]:
         """How many people each box (K, 4) holds side by side.

@@ -48,6 +48,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack import _stats
 from pftrack._check import brief, number, path_arg, real, shown
 from pftrack._text import counted, listed
 from pftrack._threads import wait_through_interrupts
@@ -153,7 +154,7 @@ def _stamped_rate(path: Path) -> float | None:
     steps = steps[np.isfinite(steps) & (steps > 0)]
     if len(steps) == 0:
         return None
-    rate = 1000.0 / float(np.median(steps))
+    rate = 1000.0 / _stats.median(steps)
     return rate if 0 < rate < 1000 else None
 
 
@@ -185,7 +186,7 @@ def _uneven_steps(stamps: Sequence[float]) -> tuple[float, float, float] | None:
     steps = steps[np.isfinite(steps) & (steps > 0)]
     if len(steps) < 10:
         return None
-    median = float(np.median(steps))
+    median = _stats.median(steps)
     off = np.abs(steps - median) > max(UNEVEN_STEP * median, UNEVEN_MS)
     if np.count_nonzero(off) <= UNEVEN_SHARE * len(steps):
         return None

@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 import pftrack._core as _core
+from pftrack._stats import unique_values
 from pftrack._threads import kernel_threads
 from pftrack._typing import F64
 from pftrack.kalman import cv_transition, wna_Q
@@ -317,7 +318,7 @@ def stand_hypotheses(T: int, grid: int = GRID) -> tuple[NDArray[np.int32], NDArr
 
 @lru_cache(maxsize=1024)
 def _stand_hypotheses(T: int, grid: int) -> tuple[NDArray[np.int32], NDArray[np.int32]]:
-    ks = np.unique(np.round(np.linspace(0, T - 1, min(grid, T))).astype(np.int32))
+    ks = unique_values(np.round(np.linspace(0, T - 1, min(grid, T))).astype(np.int32))
     i, j = np.triu_indices(len(ks), k=1)
     t1 = np.concatenate([[-1], ks[i]]).astype(np.int32)
     t2 = np.concatenate([[-1], ks[j]]).astype(np.int32)

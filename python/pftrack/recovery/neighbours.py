@@ -21,6 +21,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._stats import median_along
 from pftrack._typing import F64
 from pftrack.recovery.segments import split_rows
 
@@ -192,7 +193,7 @@ def correct_by_neighbours(
     out = list(base)
     for (n, _), (gaps, starts) in groups.items():
         stack = np.stack([np.stack(errors[k : k + n]) for k in starts])
-        shared: NDArray[np.float64] = np.median(stack, axis=1)
+        shared: NDArray[np.float64] = median_along(stack, 1)
         for g, row in zip(gaps, shared, strict=True):
             out[g] = base[g] + row * (n / (n + 1.0))
     return out

@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack import _check
 from pftrack._check import MAX_FRAME, brief, real_array
 from pftrack._progress import progress
+from pftrack._stats import median
 from pftrack._typing import F64, IntLike, RecoveryMethod
 from pftrack.boxes import _intersection, _iou_rows, _to_cxcywh, _to_xywh
 from pftrack.detection.size_model import expected_size, head_height, theil_sen
@@ -174,7 +175,7 @@ class BoxSmoother:
                     out_p[i:j] = self.smooth(f[i:j], b[i:j], obs[i:j])
             return out_p
         z = _to_cxcywh(b)
-        height = float(np.median(b[obs, 3]))
+        height = median(b[obs, 3])
         if not height > 0:  # no scale to smooth in: the track is kept as it is, as recover does
             return np.array(b, dtype=np.float64)  # a copy
         # in track heights: the same numbers whatever the image scale (no under- or overflow)
@@ -530,7 +531,7 @@ def _judge(
         (bi, ai), (bj, aj) = segments
         if min(len(bi), len(ai), len(bj), len(aj)) < config.min_points:
             continue
-        height = float(np.median(cz[np.concatenate([bi, ai, bj, aj]), 3]))
+        height = median(cz[np.concatenate([bi, ai, bj, aj]), 3])
         if not height > 0:
             continue
         judged.append(entry)

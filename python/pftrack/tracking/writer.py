@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from pftrack._check import option
+from pftrack._stats import unique_values
 from pftrack._typing import F64
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.offline import BoxSmoother, CrossingConfig, smooth_tracks
@@ -199,14 +200,14 @@ class TrackWriter:
         z = a[:, 2:6].copy()  # the smoother fits the detection boxes, not the reported ones
         z[observed] = boxes[observed]
         cls = np.array([self._cls.get(int(i), 0) for i in a[:, 1]], np.int64)
-        classes = np.unique(cls)
+        classes = unique_values(cls)
         if len(classes) == 1:
             smoother = own.get(int(classes[0]), self.smoother)
             rows = smooth_tracks(
                 a, observed, smoother, self.link, z, crossings=crossings,
                 relink_coast=relink_coast,
             )  # fmt: skip
-            ids = np.unique(rows[:, 1]).astype(int).tolist()
+            ids = unique_values(rows[:, 1]).astype(int).tolist()
             self.classes = dict.fromkeys(ids, int(classes[0]))
             return rows
         # classes never share an identity: each class's tracks are linked among themselves, and

@@ -1,0 +1,46 @@
+"""`pftrack track`'s process skips the collector's passes at its exit; a library call does not."""
+
+from __future__ import annotations
+
+import gc
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from pftrack.cli import main
+from pftrack.synthetic import make_scene
+
+
+@pytest.fixture(scope="module")
+def video(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return make_scene(n_frames=30, rng=0).write_video(tmp_path_factory.mktemp("v") / "s.avi")
+
+
+def test_the_console_process_freezes_its_objects_once_the_outputs_are_written(
+    video: Path, tmp_path: Path
+) -> None:
+    """``gc.freeze()`` after the summary: the interpreter's exit then skips the cyclic collector's
+    passes over every object (0.15-0.2 s of a PETS09 run at load; the same file, the same
+    summary)."""
+    out = tmp_path / "t.txt"
+    code = (
+        "import atexit, gc, sys; "
+        "atexit.register(lambda: print('frozen', gc.get_freeze_count() > 0)); "
+        f"sys.argv = ['pftrack', 'track', {str(video)!r}, '--out', {str(out)!r}]; "
+        "from pftrack._console import main; sys.exit(main())"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    lines = run.stdout.splitlines()
+    assert lines[-1] == "frozen True", run.stdout
+    assert "30 frames" in lines[-2] and out.stat().st_size > 0
+
+
+def test_a_library_call_of_the_command_leaves_the_collector_alone(
+    video: Path, tmp_path: Path
+) -> None:
+    """``pftrack.cli.main(argv)`` runs inside a caller's process, which goes on: nothing frozen."""
+    before = gc.get_freeze_count()
+    assert main(["-q", "track", str(video), "--out", str(tmp_path / "t.txt")]) == 0
+    assert gc.get_freeze_count() == before
