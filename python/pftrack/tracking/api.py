@@ -353,6 +353,15 @@ def _outside_the_frame(
     return seen[0] + past, max(seen[1], float(d[:, 2].max())), max(seen[2], float(d[:, 3].max()))
 
 
+#: Boxes a run or file needs before their extent says anything about their pixels.
+SMALL_LAYOUT_BOXES = 20
+#: Share of the boxes wholly outside the frame that says they are a larger frame's pixels.
+OUTSIDE_SHARE = 0.1
+#: Round ratios of image sizes a hint names in place of an estimate just above them (the
+#: boxes seldom reach the image's last pixel: PETS09's reach 767 of 768, 0.626 for 0.625).
+ROUND_RATIOS = (0.5, 0.25, 0.625, 0.75, 0.8, 1 / 3, 2 / 3)
+
+
 def _refuse_larger_frame(
     outside: tuple[int, float, float], extent: int, shape: tuple[int, int], name: str
 ) -> None:
@@ -372,8 +381,6 @@ def _refuse_larger_frame(
     the scale is 0.625), so their reach gives an upper bound, said as one, and the round
     ratios below it with the sizes they mean.
     """
-    from pftrack.tracking.run import OUTSIDE_SHARE, ROUND_RATIOS, SMALL_LAYOUT_BOXES  # a cycle
-
     n_out, right, bottom = outside
     if extent < SMALL_LAYOUT_BOXES or n_out <= OUTSIDE_SHARE * extent:
         return

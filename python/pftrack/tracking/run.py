@@ -37,7 +37,13 @@ from pftrack.io.prefetch import prefetch
 from pftrack.io.video import FrameSource, SequenceInfo
 from pftrack.recovery.linking import LinkConfig
 from pftrack.tracking.ahead import DetectAhead
-from pftrack.tracking.api import Tracker, xywh_to_xyxy_dets
+from pftrack.tracking.api import (
+    OUTSIDE_SHARE,
+    ROUND_RATIOS,
+    SMALL_LAYOUT_BOXES,
+    Tracker,
+    xywh_to_xyxy_dets,
+)
 from pftrack.tracking.config import TrackerConfig
 from pftrack.tracking.offline import BoxSmoother
 from pftrack.tracking.track import Track
@@ -616,13 +622,6 @@ def _check_last_frame(detections: dict[int, F64], n_frames: int) -> None:
     )
 
 
-SMALL_LAYOUT_BOXES = 20  # boxes a file needs before its extent says anything about its pixels
-
-
-#: Share of a file's boxes wholly outside the frame that says they are a larger frame's pixels.
-OUTSIDE_SHARE = 0.1
-
-
 #: How far past ``seqinfo.ini``'s image size (a share of it) boxes may reach and still be taken
 #: for boxes in its pixels (detectors' boxes overhang the edge a little).
 SEQINFO_SLACK = 0.1
@@ -636,9 +635,6 @@ EDGE_REACH = 0.98
 #: 472 of 470 rows), and the scale moves boxes by under 5 %. Up to it no det.txt here (>= 98.3 %
 #: of its size) can be taken for one in the frames' pixels: that needs under (1 + 0.95) / 2.
 EDGE_MAX_SCALE = 0.95
-#: Round ratios of image sizes the hint names in place of an estimate just above them (the
-#: boxes seldom reach the image's last pixel: PETS09's reach 767 of 768, 0.626 for 0.625).
-ROUND_RATIOS = (0.5, 0.25, 0.625, 0.75, 0.8, 1 / 3, 2 / 3)
 #: How far above a round ratio (a share of it) an estimate may be to be named by it.
 ROUND_RATIO_REACH = 0.02
 
