@@ -1,7 +1,8 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator
+import re
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +19,29 @@ def dataset(name: str) -> Path:
     if not folder.is_dir():
         pytest.skip(f"dataset {name} not found at {folder}")
     return folder
+
+
+# An id naming an object by its address (``<object object at 0x7f...>``, from ``ids=repr``)
+_ADDRESS = re.compile(r" at 0x[0-9a-fA-F]+")
+
+
+def ids_with_addresses(nodeids: Iterable[str]) -> list[str]:
+    """The test ids that hold a memory address: each process collects another name for them."""
+    return [n for n in nodeids if _ADDRESS.search(n)]
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Refuse test ids that differ from process to process.
+
+    .ci/run runs the suite on two pytest-xdist processes, which must collect the same ids: one
+    id holding an address (``ids=repr`` of an ``object()``) failed the whole run at collection.
+    """
+    bad = ids_with_addresses(item.nodeid for item in items)
+    if bad:
+        raise pytest.UsageError(
+            f"{len(bad)} test ids hold a memory address, another in each process (give the "
+            f"parameter an id): {bad[0]}"
+        )
 
 
 @pytest.fixture

@@ -32,7 +32,13 @@ CALLS: dict[str, Callable[[object], object]] = {
 }
 
 
-@pytest.mark.parametrize("value", [None, 3, 2.5, ROWS, ["a.txt"], object()], ids=repr)
+# ids the same in every process (pytest-xdist's workers must collect the same names): an
+# object()'s repr holds its address
+@pytest.mark.parametrize(
+    "value",
+    [None, 3, 2.5, ROWS, ["a.txt"], object()],
+    ids=lambda v: "object()" if type(v) is object else repr(v),
+)
 @pytest.mark.parametrize("name", list(CALLS))
 def test_a_path_of_the_wrong_type_is_named(name: str, value: object) -> None:
     with pytest.raises(TypeError) as info:
