@@ -120,7 +120,7 @@ def test_the_set_up_commands_are_the_two_ci_runs() -> None:
         "python3 -m venv .venv && . .venv/bin/activate && python -m pip install . && pftrack demo"
     )
     ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()
-    assert tests in ci and tests.endswith("python -m pytest")
+    assert tests in ci and tests.endswith("python -m pytest -n 2 --dist loadfile")
 
 
 def test_goals_is_one_short_row_per_goal() -> None:
