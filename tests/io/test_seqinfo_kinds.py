@@ -77,11 +77,8 @@ def test_a_non_ascii_im_dir_is_read_in_the_file_s_encoding(tmp_path: Path, encod
     assert main(["-q", "track", str(seq), "--out", str(tmp_path / "t.txt")]) == 0
 
 
-def test_a_seqinfo_larger_than_its_frames_beside_their_detections_is_refused(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    """Was a strict xfail (left61): scaled by 0.8 with a note only, exit 0 (5 tracks, 118
-    boxes). Refused now, naming both sizes; --det-scale 1 takes the boxes as given."""
+def _tud_as_800x600(tmp_path: Path) -> Path:
+    """A TUD-Campus sequence folder (its det.txt and video) whose seqinfo.ini says 800x600."""
     tud = dataset("tud-campus")
     seq = tmp_path / "tud125"
     seq.mkdir()
@@ -91,6 +88,15 @@ def test_a_seqinfo_larger_than_its_frames_beside_their_detections_is_refused(
     (seq / "seqinfo.ini").write_text(
         ini.replace("imWidth=640", "imWidth=800").replace("imHeight=480", "imHeight=600")
     )
+    return seq
+
+
+def test_a_seqinfo_larger_than_its_frames_beside_their_detections_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Was a strict xfail (left61): scaled by 0.8 with a note only, exit 0 (5 tracks, 118
+    boxes). Refused now, naming both sizes; --det-scale 1 takes the boxes as given."""
+    seq = _tud_as_800x600(tmp_path)
     argv = ["-q", "track", str(seq), "--detections", str(seq / "det.txt"),
             "--out", str(tmp_path / "t.txt")]  # fmt: skip
     assert main(argv) == 2
@@ -113,15 +119,7 @@ def test_a_det_scale_stated_equal_to_seqinfo_s_ratio_is_taken(tmp_path: Path) ->
     """Was refused as the automatic scale 0.8 is above (left61, frames61): a user who states
     the scale seqinfo.ini gives says the boxes are in its pixels; only the scale nobody gave is
     doubted. The Python API alike: load_detections(scale=0.8) is stated."""
-    tud = dataset("tud-campus")
-    seq = tmp_path / "tud125"
-    seq.mkdir()
-    shutil.copy(tud / "det.txt", seq / "det.txt")
-    (seq / "video.mp4").symlink_to(tud / "video.mp4")
-    ini = (tud / "seqinfo.ini").read_text()
-    (seq / "seqinfo.ini").write_text(
-        ini.replace("imWidth=640", "imWidth=800").replace("imHeight=480", "imHeight=600")
-    )
+    seq = _tud_as_800x600(tmp_path)
     out = tmp_path / "t.txt"
     argv = ["-q", "track", str(seq), "--detections", str(seq / "det.txt"), "--out", str(out)]
     assert main([*argv, "--det-scale", "0.8"]) == 0
