@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterable, Sequence
-from typing import TYPE_CHECKING, Any, TypedDict
+from typing import TYPE_CHECKING, Any, TypedDict, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -172,7 +172,8 @@ class SupervisionTracker:
             NaN or inf in ``xyxy`` or ``confidence``, a ``class_id`` that is not an integer
             (each named by its field and row), or what :meth:`pftrack.Tracker.update` refuses.
         """
-        return self._track(detections, frame, every=False)
+        dets = self._dets(detections)
+        return self._detections(detections, self.tracker.update(dets, frame), every=False)
 
     def update(self, detections: sv.Detections, frame: NDArray[np.uint8]) -> sv.Detections:
         """Track one frame's detections as the ``trackers`` package's trackers do: return all.
@@ -205,12 +206,16 @@ class SupervisionTracker:
         TypeError, ValueError
             As :meth:`update_with_detections`.
         """
-        return self._track(detections, frame, every=True)
+        dets = self._dets(detections)
+        return self._detections(detections, self.tracker.update(dets, frame), every=True)
 
-    def _track(
-        self, detections: sv.Detections, frame: NDArray[np.uint8], every: bool
-    ) -> sv.Detections:
-        """:meth:`update_with_detections` (`every` False) or :meth:`update` (`every` True)."""
+    @staticmethod
+    def _dets(detections: sv.Detections) -> F64:
+        """`detections` as :meth:`pftrack.Tracker.update`'s (N, 6) x1, y1, x2, y2, conf, cls.
+
+        The tracker is called from :meth:`update` and :meth:`update_with_detections`
+        themselves, so its warnings name the user's line one method up (``_caller_depth``).
+        """
         detections_cls = _detections_class()
         if not isinstance(detections, detections_cls):
             raise TypeError(
@@ -223,11 +228,16 @@ class SupervisionTracker:
             np.ones(n) if conf is None else _field(conf, "confidence", (n, 1)),
             np.zeros(n) if cls is None else _field(cls, "class_id", (n, 1)),
         ])  # fmt: skip
-        self.tracker._caller_depth = 2  # warnings name the user's line: past a method and this
-        try:
-            tracks = self.tracker.update(dets, frame)
-        finally:
-            self.tracker._caller_depth = 1  # finalize's and prime's: one method
+        return dets
+
+    @staticmethod
+    def _detections(detections: sv.Detections, tracks: F64, every: bool) -> sv.Detections:
+        """`detections` with the ids of `tracks` (:meth:`pftrack.Tracker.update`'s rows).
+
+        The tracked ones (`every` False: :meth:`update_with_detections`) or all, -1 on the
+        untracked (`every` True: :meth:`update`).
+        """
+        n = len(detections)
         # the input's order, as ByteTrack keeps it (a blob's tracks in track order)
         tracks = tracks[np.argsort(tracks[:, 7], kind="stable")]
         rows = tracks[:, 7].astype(np.int64)
@@ -241,13 +251,12 @@ class SupervisionTracker:
             ids = np.concatenate([ids, np.full(len(rest), -1)])[order]
             shared = np.concatenate([shared, np.zeros(len(rest), bool)])[order]
             boxes = np.concatenate([boxes, np.zeros((len(rest), 4))])[order]
-        out = detections[rows]
+        out = cast("sv.Detections", detections[rows])  # an index array: a Detections
         if shared.any():  # each track its own box, in the input's dtype
             out.xyxy = np.array(out.xyxy, copy=True)
             out.xyxy[shared] = boxes[shared].astype(out.xyxy.dtype)
         out.tracker_id = ids
-        result: sv.Detections = out
-        return result
+        return out
 
     def prime(self, frames: Iterable[NDArray[np.uint8]]) -> None:
         """Start the background behind box refinement from `frames` (:meth:`pftrack.Tracker.prime`).
