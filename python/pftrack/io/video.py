@@ -1442,13 +1442,15 @@ def _header_size(path: Path) -> tuple[int, int] | None:
     return None
 
 
-def _odd_size(images: Sequence[Path], first: int) -> tuple[Path, tuple[int, int]] | None:
+def _odd_size(
+    images: Sequence[Path], first: int
+) -> tuple[Path, tuple[int, int], tuple[int, int]] | None:
     """The first image of a folder whose header's size is another than image `first`'s.
 
     :func:`_header_size` of each (PNG and JPEG; another format, or one not told, is checked
     when read, :meth:`FrameSource._read_image`). A size that is the other turned (``480x640``
     beside ``640x480``) is left to the read: an EXIF orientation may turn it back. Returns the
-    image and its size, or None.
+    image, its size and image `first`'s, or None.
     """
     size = _header_size(images[first])
     if size is None:
@@ -1457,7 +1459,7 @@ def _odd_size(images: Sequence[Path], first: int) -> tuple[Path, tuple[int, int]
     for path in images:
         other = _header_size(path)
         if other is not None and other != size and other != turned:
-            return path, other
+            return path, other, size
     return None
 
 
@@ -1991,9 +1993,9 @@ class FrameSource:
             self.lead_black = k
             odd = _odd_size(self._images, k)  # before any work (was: when reached, minutes on)
             if odd is not None:
-                w0, h0 = _header_size(path) or (0, 0)
+                image, (w, h), (w0, h0) = odd
                 raise ValueError(
-                    f"image {odd[0]} is {odd[1][0]}x{odd[1][1]} but {path.name} is {w0}x{h0}: "
+                    f"image {image} is {w}x{h} but {path.name} is {w0}x{h0}: "
                     "every image of a folder must have one size"
                 )
             return first, len(self._images)
