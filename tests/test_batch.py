@@ -3222,11 +3222,13 @@ def test_the_workers_are_counted_by_the_scheduler_not_a_stale_cache(
     ):
         watch = engine._WorkersWatch(c, client.scheduler.address, 60.0)
         counts = []
+        # At least 1.5 s of the 5 ms refresh and at least 200 counts, however slow the machine
+        # (was: as many counts as 1.5 s gave, asked to be over 100: 59 at load 20).
         deadline = time.monotonic() + 1.5
-        while time.monotonic() < deadline:
+        while time.monotonic() < deadline or len(counts) < 200:
             counts.append(engine._n_workers(c))
             assert not watch.given_up()  # and no warning: an error in this module
-        assert set(counts) == {2} and len(counts) > 100
+        assert set(counts) == {2}
         assert engine._wait_for_workers(c, client.scheduler.address, 1.0) == 2
 
 
