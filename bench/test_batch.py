@@ -8,7 +8,10 @@ nice pytest bench/test_batch.py --benchmark-enable --benchmark-only --benchmark-
   ``pftrack track``'s defaults, one after the other in this process (``n_workers=0``, OpenCV
   at one thread as ``pftrack track`` and ``pftrack batch --workers 0`` set it) and on a warm
   two-worker ``LocalCluster``; and once more including the cluster's start and close, as
-  ``pftrack batch`` does it. Goal: serial / two workers >= 1.7 on two cores.
+  ``pftrack batch`` does it. Goal: serial / two workers >= 1.7 on two cores. Untimed
+  (``--benchmark-disable``, as CI runs the benchmarks as tests) the three cases take the smallest
+  input that still runs the same path, four links to a synthetic 160x120 video of 8 frames (they
+  took 27 % of CI's bench step on PETS09's 795 frames); ``extra_info["video"]`` says so.
 - ``batch overhead``: 40 tiny sequences (3 frames of 64x64): the scheduler's cost per sequence,
   ``2 * t_dask / n - t_serial / n`` (worker-seconds per sequence beyond the work), goal <= 0.5 s.
 - ``batch memory``: 100 tiny sequences on the two workers; each worker's resident memory after
@@ -44,19 +47,42 @@ def client() -> Iterator[Any]:
 
 #: ``extra_info["video"]`` of the four-sequence cases on the data's video.
 PETS_VIDEO = "PETS09-S2L1 video.avi"
-VIDEO: dict[str, str] = {}  # "four" -> what the four sequences are (PETS_VIDEO or why not)
+VIDEO: dict[Path, str] = {}  # a four-sequence folder -> what its sequences are
+
+
+def _four_links(folder: Path, video: Path, what: str) -> Path:
+    for k in range(1, 5):
+        (folder / f"seq{k}.avi").symlink_to(video)  # a link, not a copy of the data
+    VIDEO[folder] = what
+    return folder
 
 
 @pytest.fixture(scope="module")
-def four_sequences(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+def four_timed(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("four")
     video = data_dir / "pets09-s2l1" / "video.avi"
-    VIDEO["four"] = PETS_VIDEO
-    if not video.is_file():
-        VIDEO["four"] = f"synthetic 480x360 scene, 795 frames (no PETS09-S2L1 video at {video})"
-        video = make_scene(n_frames=795, rng=0).write_video(folder.parent / "synthetic.avi")
-    for k in range(1, 5):
-        (folder / f"seq{k}.avi").symlink_to(video)  # a link, not a copy of the data
+    if video.is_file():
+        return _four_links(folder, video, PETS_VIDEO)
+    what = f"synthetic 480x360 scene, 795 frames (no PETS09-S2L1 video at {video})"
+    video = make_scene(n_frames=795, rng=0).write_video(folder.parent / "synthetic.avi")
+    return _four_links(folder, video, what)
+
+
+@pytest.fixture(scope="module")
+def four_untimed(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Four links to an 8-frame 160x120 video: its walkers are born and tracked on the timed
+    cases' path (video files, ``pftrack track``'s defaults) in a fraction of a second."""
+    folder = tmp_path_factory.mktemp("four_untimed")
+    scene = make_scene(n_frames=8, width=160, height=120, n_walkers=2, rng=0)
+    video = scene.write_video(folder.parent / "untimed.avi")
+    return _four_links(folder, video, "synthetic 160x120 scene, 8 frames (--benchmark-disable)")
+
+
+@pytest.fixture
+def four_sequences(benchmark: BenchmarkFixture, request: pytest.FixtureRequest) -> Path:
+    """:func:`four_timed` when timed, :func:`four_untimed` under ``--benchmark-disable``; only
+    the one used is built (without the data, the 795-frame scene is written only to be timed)."""
+    folder: Path = request.getfixturevalue("four_untimed" if benchmark.disabled else "four_timed")
     return folder
 
 
@@ -84,7 +110,7 @@ TIMES: dict[str, float] = {}  # the serial time, for the speed-up printed by the
 
 
 def _timed(benchmark: BenchmarkFixture, key: str, *args: Any, **kwargs: Any) -> float:
-    video = VIDEO["four"]
+    video = VIDEO[args[0]]
     if video != PETS_VIDEO:  # another workload under another name, as bench/conftest.py's frames
         benchmark.group = f"{benchmark.group} [synthetic scene]"
     seconds = float(benchmark.pedantic(_run, args, kwargs, rounds=1))

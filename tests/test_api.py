@@ -219,16 +219,10 @@ def test_recover_loads_no_tracker(tmp_path: Path) -> None:
     assert (tmp_path / "o.txt").read_text().count("\n") == 4  # frames 2 and 3 filled
 
 
-def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """mypy sees the real signatures through the lazy re-exports (and the package's py.typed)."""
-    api = pytest.importorskip("mypy.api")
-    root = Path(pftrack.__file__).parents[1]
-    if root.name not in ("site-packages", "dist-packages"):
-        # a source checkout (PYTHONPATH=python): mypy finds installed packages by itself and
-        # refuses site-packages on MYPYPATH
-        monkeypatch.setenv("MYPYPATH", str(root))
-    code = tmp_path / "use.py"
-    code.write_text(
+#: The scripts mypy checks, in one run for the tests below (a cold ``mypy --strict`` through
+#: pftrack's imports took 100 s of each test's 110 s on a busy 2-core machine: one run, not two).
+TYPED_SCRIPTS = {
+    "use.py": (
         "import pftrack\n"
         "reveal_type(pftrack.read_mot)\n"
         "reveal_type(pftrack.FrameSource('x').fps)\n"
@@ -244,9 +238,57 @@ def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
         "pftrack.track_frames([], bootstrap='sprad')\n"
         "from pftrack.integrations.supervision import SupervisionTracker\n"
         "SupervisionTracker(frame_rate=25.0, sed=1, detector='mog3')\n"
-    )
-    out, _, status = api.run(["--strict", "--no-incremental", "--follow-imports=silent", str(code)])
-    assert status == 1, out  # the bad call is caught, so the names are not Any
+    ),
+    "rates.py": (
+        "from fractions import Fraction\n"
+        "import numpy as np\n"
+        "import pftrack\n"
+        "from pftrack.integrations.supervision import SupervisionTracker\n"
+        "from pftrack.detection.bootstrap import bootstrap_frames\n"
+        "rate = Fraction(30000, 1001)\n"
+        "pftrack.Tracker(frame_rate=rate, max_coast=Fraction(1, 2), prime=np.float32(1))\n"
+        "pftrack.Tracker(frame_rate=np.float32(25))\n"
+        "pftrack.Tracker.from_config(frame_rate=rate, prime_frames=np.int64(3))\n"
+        "SupervisionTracker(frame_rate=rate, max_coast=rate, prime=np.float64(1))\n"
+        "pftrack.VideoWriter('a.mp4', rate)\n"
+        "pftrack.TrackRenderer('a.mp4', np.float32(25))\n"
+        "pftrack.FrameSource('a.mp4', fps=rate)\n"
+        "pftrack.make_scene(fps=rate)\n"
+        "pftrack.write_annotated_video('a.mp4', [], np.zeros((0, 10)), fps=rate)\n"
+        "pftrack.fill_gaps(np.zeros((0, 10)), max_gap=np.int64(3))\n"
+        "pftrack.smooth_tracks(np.zeros((0, 10)), max_gap=np.int64(3))\n"
+        "pftrack.track_frames('a.mp4', prime_frames=np.int64(3))\n"
+        "bootstrap_frames([], np.int64(3))\n"
+        "pftrack.Tracker(frame_rate='25')\n"
+    ),
+}
+
+
+@pytest.fixture(scope="module")
+def mypy_says(tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
+    """``mypy --strict`` on :data:`TYPED_SCRIPTS`, once: each script's lines of its report."""
+    api = pytest.importorskip("mypy.api")
+    folder = tmp_path_factory.mktemp("typed")
+    for name, code in TYPED_SCRIPTS.items():
+        (folder / name).write_text(code)
+    root = Path(pftrack.__file__).parents[1]
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        if root.name not in ("site-packages", "dist-packages"):
+            # a source checkout (PYTHONPATH=python): mypy finds installed packages by itself and
+            # refuses site-packages on MYPYPATH
+            monkeypatch.setenv("MYPYPATH", str(root))
+        files = [str(folder / name) for name in TYPED_SCRIPTS]
+        out, _, _ = api.run(["--strict", "--no-incremental", "--follow-imports=silent", *files])
+    lines = out.splitlines()
+    return {
+        n: "\n".join(x for x in lines if x.startswith(str(folder / n) + ":")) for n in TYPED_SCRIPTS
+    }
+
+
+def test_the_api_is_typed(mypy_says: dict[str, str]) -> None:
+    """mypy sees the real signatures through the lazy re-exports (and the package's py.typed)."""
+    out = mypy_says["use.py"]
+    assert ": error:" in out, out  # the bad call is caught, so the names are not Any
     assert 'Revealed type is "def (path: ' in out
     assert 'Revealed type is "float"' in out or 'Revealed type is "builtins.float"' in out
     assert 'Argument "method" to "fill_gaps" has incompatible type "Literal[2]"' in out
@@ -269,40 +311,13 @@ def test_the_api_is_typed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> No
 
 
 def test_what_docs_api_says_rates_seconds_and_counts_take_type_checks(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    mypy_says: dict[str, str],
 ) -> None:
     """docs/api.md: every frame rate and time in seconds takes any real number (a Fraction,
     PyAV's ``stream.average_rate``; a NumPy scalar), and frame counts NumPy's ints; the
     annotations said ``float`` and ``int``, so mypy --strict refused each call below, which
     runs."""
-    api = pytest.importorskip("mypy.api")
-    root = Path(pftrack.__file__).parents[1]
-    if root.name not in ("site-packages", "dist-packages"):
-        monkeypatch.setenv("MYPYPATH", str(root))
-    code = tmp_path / "rates.py"
-    code.write_text(
-        "from fractions import Fraction\n"
-        "import numpy as np\n"
-        "import pftrack\n"
-        "from pftrack.integrations.supervision import SupervisionTracker\n"
-        "from pftrack.detection.bootstrap import bootstrap_frames\n"
-        "rate = Fraction(30000, 1001)\n"
-        "pftrack.Tracker(frame_rate=rate, max_coast=Fraction(1, 2), prime=np.float32(1))\n"
-        "pftrack.Tracker(frame_rate=np.float32(25))\n"
-        "pftrack.Tracker.from_config(frame_rate=rate, prime_frames=np.int64(3))\n"
-        "SupervisionTracker(frame_rate=rate, max_coast=rate, prime=np.float64(1))\n"
-        "pftrack.VideoWriter('a.mp4', rate)\n"
-        "pftrack.TrackRenderer('a.mp4', np.float32(25))\n"
-        "pftrack.FrameSource('a.mp4', fps=rate)\n"
-        "pftrack.make_scene(fps=rate)\n"
-        "pftrack.write_annotated_video('a.mp4', [], np.zeros((0, 10)), fps=rate)\n"
-        "pftrack.fill_gaps(np.zeros((0, 10)), max_gap=np.int64(3))\n"
-        "pftrack.smooth_tracks(np.zeros((0, 10)), max_gap=np.int64(3))\n"
-        "pftrack.track_frames('a.mp4', prime_frames=np.int64(3))\n"
-        "bootstrap_frames([], np.int64(3))\n"
-        "pftrack.Tracker(frame_rate='25')\n"
-    )
-    out, _, status = api.run(["--strict", "--no-incremental", "--follow-imports=silent", str(code)])
+    out = mypy_says["rates.py"]
     errors = [line for line in out.splitlines() if ": error:" in line]
     # only the str, which the runtime refuses too: the rest type-checks
     assert [e.split(":")[1] for e in errors] == ["20"], out
