@@ -654,3 +654,16 @@ def test_video_ids_of_people_side_by_side_do_not_overlap(monkeypatch: pytest.Mon
     height = boxes[0][3] - boxes[0][1] + 1
     assert all(abs(b[1] - boxes[0][1]) <= 3 * height for b in boxes[1:4]), boxes
     assert boxes[4][1] > first[-1][3], boxes  # id 15 just under the frame number
+
+
+@pytest.mark.parametrize("threaded", [False, True])
+def test_a_track_with_a_nan_box_is_named_by_add_itself(tmp_path: Path, threaded: bool) -> None:
+    """The worker draws rows ``add`` checked (not checked again each frame): a NaN box is a
+    ValueError of ``add`` naming the tracks, in the caller's thread, and no file is left."""
+    renderer = TrackRenderer(tmp_path / "v.mp4", 7, threaded=threaded)
+    renderer.add(np.zeros((40, 60, 3), np.uint8), _walk(1)[0])
+    bad = [FakeTrack(5, np.array([10.0, np.nan, 12.0, 30.0]))]
+    with pytest.raises(ValueError, match=r"^TrackRenderer.add: tracks row 0 has NaN or inf in "):
+        renderer.add(np.zeros((40, 60, 3), np.uint8), bad)
+    renderer.abort()
+    assert not (tmp_path / "v.mp4").exists()

@@ -128,8 +128,12 @@ def _filled(rows: F64) -> NDArray[np.bool_]:
     return out
 
 
+@functools.lru_cache(maxsize=4096)
 def _text_size(text: str, scale: float, k: int) -> tuple[tuple[int, int], int]:
-    """``cv2.getTextSize`` of `text` as :func:`_tag` draws it: ((width, height), baseline)."""
+    """``cv2.getTextSize`` of `text` as :func:`_tag` draws it: ((width, height), baseline).
+
+    Cached: a video asks again for the size of each id on every frame it is drawn on.
+    """
     (tw, th), base = cv2.getTextSize(text_for_opencv(text), cv2.FONT_HERSHEY_SIMPLEX, scale, k)
     return (tw, th), base
 
@@ -501,7 +505,10 @@ class TrackRenderer:
         for tid in set(self._trails) - seen:
             del self._trails[tid]
         trails = {tid: list(pts) for tid, pts in self._trails.items()}
-        job = (self._n, frame, np.asarray(rows, dtype=np.float64).reshape(-1, 10), trails)
+        table = np.asarray(rows, dtype=np.float64).reshape(-1, 10)
+        if not np.isfinite(table[:, :6]).all():  # named here, in the caller's thread (was: by
+            _track_rows(table, "TrackRenderer.add", "tracks")  # the worker, at a later call)
+        job = (self._n, frame, table, trails)
         if self._queue is None:
             self._draw(job)
         else:
@@ -526,7 +533,8 @@ class TrackRenderer:
 
     def _draw(self, job: _Job) -> None:
         n, frame, rows, trails = job
-        image = draw_tracks(frame, rows, f"frame {n}")
+        # the frame and rows were checked by add (was: checked again here, each frame)
+        image = _draw_boxes(frame, rows, f"frame {n}")
         draw_trails(image, trails)
         self.writer.write(image)
 
