@@ -44,3 +44,22 @@ def test_a_library_call_of_the_command_leaves_the_collector_alone(
     before = gc.get_freeze_count()
     assert main(["-q", "track", str(video), "--out", str(tmp_path / "t.txt")]) == 0
     assert gc.get_freeze_count() == before
+
+
+@pytest.mark.parametrize("command", ["recover", "smooth"])
+def test_every_command_freezes_its_objects_in_the_console_process(
+    video: Path, tmp_path: Path, command: str
+) -> None:
+    """Was: ``pftrack track`` alone; ``recover`` and ``smooth`` paid the collector's passes
+    over every object at their exit too."""
+    tracks, out = tmp_path / "t.txt", tmp_path / "o.txt"
+    assert main(["-q", "track", str(video), "--out", str(tracks)]) == 0
+    code = (
+        "import atexit, gc, sys; "
+        "atexit.register(lambda: print('frozen', gc.get_freeze_count() > 0)); "
+        f"sys.argv = ['pftrack', '-q', {command!r}, {str(tracks)!r}, '--out', {str(out)!r}]; "
+        "from pftrack._console import main; sys.exit(main())"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert run.stdout.splitlines()[-1] == "frozen True", run.stdout
+    assert out.stat().st_size > 0

@@ -616,3 +616,54 @@ def test_plot_ids_of_paths_that_begin_or_end_together_do_not_overlap(
         for b in boxes[:i]:
             apart = a[2] < b[0] or b[2] < a[0] or a[3] < b[1] or b[3] < a[1]
             assert apart, (a, b)
+
+
+def test_video_ids_of_people_side_by_side_do_not_overlap(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Was (issue 17): ``--render``'s id tags drawn over one another for people walking side by
+    side, and over the frame number in the corner. Four boxes whose tags would share one place
+    and one under the frame number: every tag is moved apart the least, inside the frame, and
+    the frame number stays in its corner."""
+    import pftrack.render as render
+
+    boxes: list[tuple[int, int, int, int]] = []
+
+    def spy(*args: Any, **kwargs: Any) -> tuple[int, int, int, int]:
+        box = tag(*args, **kwargs)
+        boxes.append(box)
+        return box
+
+    tag = render._tag
+    monkeypatch.setattr(render, "_tag", spy)
+    rows = np.array(
+        [[1, tid, left, 60.0 if tid < 15 else 24.0, 30.0, 60.0, 1, -1, -1, -1]
+         for tid, left in ((11, 100.0), (12, 104.0), (13, 96.0), (14, 102.0), (15, 8.0))]
+    )  # fmt: skip
+    alone = render.draw_tracks(np.zeros((160, 240, 3), np.uint8), rows[:1], "frame 1")
+    first = boxes[:]
+    boxes.clear()
+    out = render.draw_tracks(np.zeros((160, 240, 3), np.uint8), rows, "frame 1")
+    assert len(boxes) == 6 and boxes[0] == first[0] and boxes[-1] == first[-1]
+    for i, a in enumerate(boxes):
+        assert 0 <= a[0] <= a[2] < 240 and 0 <= a[1] <= a[3] < 160, a  # whole inside
+        for b in boxes[:i]:
+            apart = a[2] < b[0] or b[2] < a[0] or a[3] < b[1] or b[3] < a[1]
+            assert apart, (a, b)
+    # the frame number where it was, over the boxes; the first id too, the others each within
+    # a few tags' heights of where it was asked
+    np.testing.assert_array_equal(out[: first[-1][3] + 1, :60], alone[: first[-1][3] + 1, :60])
+    height = boxes[0][3] - boxes[0][1] + 1
+    assert all(abs(b[1] - boxes[0][1]) <= 3 * height for b in boxes[1:4]), boxes
+    assert boxes[4][1] > first[-1][3], boxes  # id 15 just under the frame number
+
+
+@pytest.mark.parametrize("threaded", [False, True])
+def test_a_track_with_a_nan_box_is_named_by_add_itself(tmp_path: Path, threaded: bool) -> None:
+    """The worker draws rows ``add`` checked (not checked again each frame): a NaN box is a
+    ValueError of ``add`` naming the tracks, in the caller's thread, and no file is left."""
+    renderer = TrackRenderer(tmp_path / "v.mp4", 7, threaded=threaded)
+    renderer.add(np.zeros((40, 60, 3), np.uint8), _walk(1)[0])
+    bad = [FakeTrack(5, np.array([10.0, np.nan, 12.0, 30.0]))]
+    with pytest.raises(ValueError, match=r"^TrackRenderer.add: tracks row 0 has NaN or inf in "):
+        renderer.add(np.zeros((40, 60, 3), np.uint8), bad)
+    renderer.abort()
+    assert not (tmp_path / "v.mp4").exists()

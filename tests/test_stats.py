@@ -111,3 +111,22 @@ def test_the_masked_check_passes_while_another_thread_imports_numpy_ma(
     masked = np.ma.masked_array([1.0, 2.0], mask=[True, False])
     with pytest.raises(TypeError, match="rows is a numpy.ma.MaskedArray with 1 masked value"):
         refuse_masked(masked, "rows")
+
+
+@pytest.mark.parametrize("command", ["recover", "smooth"])
+def test_recover_and_smooth_never_import_numpy_ma(tmp_path: Path, command: str) -> None:
+    """Was: ``np.isin`` in ``recovery.fill.copied_values`` (``pftrack recover``) and
+    ``np.unique`` in the summary of ``pftrack smooth`` imported ``numpy.ma`` (15-20 ms of CPU)."""
+    from bench.recovery_file import synthetic_tracks
+    from pftrack.io.mot import write_mot
+
+    tracks = tmp_path / "t.txt"
+    write_mot(tracks, synthetic_tracks(20, seed=1, n_frames=300))
+    code = (
+        "import sys; from pftrack.cli import main; "
+        f"status = main(['-q', {command!r}, {str(tracks)!r}, '--out', "
+        f"{str(tmp_path / 'o.txt')!r}]); print(status, 'numpy.ma' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split()[-2:] == ["0", "False"], out.stderr
+    assert (tmp_path / "o.txt").stat().st_size > (tmp_path / "t.txt").stat().st_size  # filled

@@ -91,7 +91,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         # the process ends with the command: a Ctrl-C once its outputs are in place is ignored
         # to the exit (was: exit status 130, no word, after the output was written)
         _signals.PROCESS_ENDS = argv is None
-        return run(argv)
+        status = run(argv)
+        if argv is None:  # every command (was: `pftrack track` alone)
+            import gc
+
+            # The interpreter's exit runs the cyclic collector over every object while it
+            # tears the modules down: 0.15-0.2 s of a `track` run at load, 0.04 s quiet, for
+            # memory the process gives back anyway. Frozen, the objects are left out of those
+            # passes (every output is closed and stdout flushed by the command; atexit
+            # handlers still run).
+            gc.freeze()
+        return status
     except Exception:
         from pftrack import _interrupt  # (loaded first in the try: cannot fail here)
 

@@ -89,6 +89,18 @@ def _draw_boxes(frame: NDArray[np.uint8], rows: F64, label: str) -> NDArray[np.u
     """:func:`draw_tracks` of rows checked already (each frame of a video whose rows were)."""
     out: NDArray[np.uint8] = frame.copy()
     k = ink_scale(out.shape)
+    # the tags drawn so far: each id's tag misses them when there is room, moved up or down the
+    # least (was: ids of people walking side by side drawn over one another, and over the
+    # frame number)
+    taken: list[Box] = []
+    size = _text_size(label, 0.45 * k, k) if label else ((0, 0), 0)
+    (tw, _), base = size
+    # only where it fits in a corner (was: on a 32x24 frame, a tag over two thirds of it)
+    corner = (
+        bool(label) and 2 * (6 * k + tw) <= out.shape[1] and 3 * (15 * k + base) <= out.shape[0]
+    )
+    if corner:  # its place is taken now; it is drawn last, over the boxes, as before
+        taken.append(_tag_place(out.shape, (5 * k, 15 * k), k, size)[1])
     # was: column 8 == 1 alone, drawn thin: every box of MOT16+ truth (class 1, pedestrian)
     filled = _filled(rows)
     for i, r in enumerate(rows):
@@ -101,13 +113,9 @@ def _draw_boxes(frame: NDArray[np.uint8], rows: F64, label: str) -> NDArray[np.u
             cv2.rectangle(out, (x, y), (x + w, y + h), c, 2 * k)
         # the whole label inside the frame, over the part of the box that is (was: at the box's
         # left edge, off the frame for a box entering from the left, cut for one leaving right)
-        _tag(out, str(tid), (x, y - 3 * k), 0.4 * k, c, k)
-    if label:
-        size = _text_size(label, 0.45 * k, k)
-        (tw, _), base = size
-        # only where it fits in a corner (was: on a 32x24 frame, a tag over two thirds of it)
-        if 2 * (6 * k + tw) <= out.shape[1] and 3 * (15 * k + base) <= out.shape[0]:
-            _tag(out, label, (5 * k, 15 * k), 0.45 * k, (0, 0, 0), k, size)
+        _tag(out, str(tid), (x, y - 3 * k), 0.4 * k, c, k, None, taken)
+    if corner:
+        _tag(out, label, (5 * k, 15 * k), 0.45 * k, (0, 0, 0), k, size)
     return out
 
 
@@ -120,8 +128,12 @@ def _filled(rows: F64) -> NDArray[np.bool_]:
     return out
 
 
+@functools.lru_cache(maxsize=4096)
 def _text_size(text: str, scale: float, k: int) -> tuple[tuple[int, int], int]:
-    """``cv2.getTextSize`` of `text` as :func:`_tag` draws it: ((width, height), baseline)."""
+    """``cv2.getTextSize`` of `text` as :func:`_tag` draws it: ((width, height), baseline).
+
+    Cached: a video asks again for the size of each id on every frame it is drawn on.
+    """
     (tw, th), base = cv2.getTextSize(text_for_opencv(text), cv2.FONT_HERSHEY_SIMPLEX, scale, k)
     return (tw, th), base
 
@@ -146,12 +158,12 @@ def _tag(
     the tags drawn before, which this one is moved up or down the least to miss, when there is
     room (:func:`_free_y`), and joins. Returns the tag's box (x0, y0, x1, y1), inclusive.
     """
-    (tw, th), base = _text_size(text, scale, k) if size is None else size
-    x = max(k, min(org[0], image.shape[1] - tw - k))
-    y = min(max(th + k, org[1]), image.shape[0] - base - k)
+    size = _text_size(text, scale, k) if size is None else size
+    (x, y), box = _tag_place(image.shape, org, k, size)
     if taken:
+        (tw, th), base = size
         y = _free_y(taken, x - k, x + tw + k - 1, y, th + k, base, image.shape[0])
-    box = (x - k, y - th - k, x + tw + k - 1, y + base)
+        box = (x - k, y - th - k, x + tw + k - 1, y + base)
     if taken is not None:
         taken.append(box)
     cv2.rectangle(image, box[:2], box[2:], colour, -1)
@@ -161,6 +173,20 @@ def _tag(
         image, text_for_opencv(text), (x, y), cv2.FONT_HERSHEY_SIMPLEX, scale, ink, k, cv2.LINE_AA
     )
     return box
+
+
+def _tag_place(
+    shape: tuple[int, ...], org: tuple[int, int], k: int, size: tuple[tuple[int, int], int]
+) -> tuple[tuple[int, int], Box]:
+    """Where :func:`_tag` puts a tag of `size` asked at `org` on an image of `shape`.
+
+    Whole inside the image, before it misses other tags: its text's origin (x, y) and its box
+    (x0, y0, x1, y1), inclusive.
+    """
+    (tw, th), base = size
+    x = max(k, min(org[0], shape[1] - tw - k))
+    y = min(max(th + k, org[1]), shape[0] - base - k)
+    return (x, y), (x - k, y - th - k, x + tw + k - 1, y + base)
 
 
 def _free_y(taken: list[Box], x0: int, x1: int, y: int, above: int, below: int, rows: int) -> int:
@@ -479,7 +505,10 @@ class TrackRenderer:
         for tid in set(self._trails) - seen:
             del self._trails[tid]
         trails = {tid: list(pts) for tid, pts in self._trails.items()}
-        job = (self._n, frame, np.asarray(rows, dtype=np.float64).reshape(-1, 10), trails)
+        table = np.asarray(rows, dtype=np.float64).reshape(-1, 10)
+        if not np.isfinite(table[:, :6]).all():  # named here, in the caller's thread (was: by
+            _track_rows(table, "TrackRenderer.add", "tracks")  # the worker, at a later call)
+        job = (self._n, frame, table, trails)
         if self._queue is None:
             self._draw(job)
         else:
@@ -504,7 +533,8 @@ class TrackRenderer:
 
     def _draw(self, job: _Job) -> None:
         n, frame, rows, trails = job
-        image = draw_tracks(frame, rows, f"frame {n}")
+        # the frame and rows were checked by add (was: checked again here, each frame)
+        image = _draw_boxes(frame, rows, f"frame {n}")
         draw_trails(image, trails)
         self.writer.write(image)
 

@@ -50,8 +50,7 @@ def run(args: argparse.Namespace) -> int:
         return batch.run_smooth(args)
     batch.refuse_batch_options(args)
     args.tracks = args.tracks[0]
-    import numpy as np
-
+    from pftrack._stats import unique_values
     from pftrack.cli._signals import hold_interrupts
     from pftrack.cli.recover import flag_note
     from pftrack.io.atomic import check_output
@@ -72,8 +71,8 @@ def run(args: argparse.Namespace) -> int:
     # that code in C dropped, the writer still refuses: pftrack._interrupt)
     hold_interrupts()
     write_mot(args.out, result, exact=smoothed_copies(result))  # given values: all digits
-    ids_in = len(np.unique(rows[:, 1])) if len(rows) else 0
-    ids_out = len(np.unique(result[:, 1])) if len(result) else 0
+    ids_in = len(unique_values(rows[:, 1])) if len(rows) else 0
+    ids_out = len(unique_values(result[:, 1])) if len(result) else 0
     to = report_stream(args.out)  # rows on stdout (--out /dev/stdout): the report not
     print(
         f"{src}: {counted(ids_in, 'id')}, {counted(len(rows), 'row')} -> "

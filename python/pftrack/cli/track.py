@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import gc
 import signal
 import sys
 import warnings
@@ -266,7 +265,6 @@ def run(args: argparse.Namespace) -> int:
     never the files.
     """
     from pftrack._stats import unique_values
-    from pftrack.cli import _signals
     from pftrack.cli._options import opencv_single_threaded
     from pftrack.cli._signals import hold_interrupts, set_outcome
     from pftrack.io.atomic import (
@@ -411,10 +409,4 @@ def run(args: argparse.Namespace) -> int:
     to = report_stream(args.out, args.render, args.plot)  # none of them on stdout's rows
     for line in said:
         print(line, file=to)
-    if _signals.PROCESS_ENDS:  # the console script's process: it ends with this command
-        # The interpreter's exit runs the cyclic collector over every object while it tears
-        # the modules down: 0.15-0.2 s of a run at load, 0.04 s quiet, for memory the process
-        # gives back anyway. Frozen, the objects are left out of those passes (every output
-        # above is closed; stdout is flushed at exit as before; atexit handlers still run).
-        gc.freeze()
     return 0
