@@ -22,7 +22,7 @@ using namespace pftrack;
 
 namespace {
 
-/// The HsvLut of the last binning asked for (tables of ~260 KB, built once per binning): the
+/// The HsvLut of the last binning asked for (tables of ~450 KB, built once per binning): the
 /// same bins as hsv_bin_of for every colour (tests/core check it), several times faster.
 std::shared_ptr<const HsvLut> cached_lut(const HsvBinning& p) {
     static std::mutex mu;

@@ -173,3 +173,27 @@ def test_random_clouds_property(specs, background, shuffle, seed):
     if shuffle:
         boxes = boxes[rng.permutation(len(boxes))]
     _weights_all_paths(image, boxes, r)
+
+
+@pytest.mark.parametrize("step", [2, 3])
+@pytest.mark.parametrize("background", [0.0, 0.5])
+def test_lattice_clouds_every_path_bit_identical(rng, step, background):
+    """On a lattice too the table's counts are read in compact form (coefficient_of_compact):
+    every method gives the direct path's weights bit for bit, and the reference's."""
+    image = _image(rng, 120, 160, background)
+    r = _reference_histogram(image, rng)
+    boxes = np.vstack(
+        [
+            _cloud(rng, (50, 60), (30, 60), 5.0, 50),
+            _cloud(rng, (120, 40), (40, 40), 8.0, 50),
+            _cloud(rng, (150, 110), (24, 30), 4.0, 20),  # clipped at the corner
+        ]
+    )
+    boxes = boxes[rng.permutation(len(boxes))]
+    want = ref.bhattacharyya_weights(
+        ref.box_histograms(image.bins, image.n_bins, boxes, "uniform", step), r, 30.0
+    )
+    got = {m: _core.box_weights(image, boxes, r, 30.0, "uniform", m, step) for m in METHODS}
+    for m in METHODS:
+        np.testing.assert_array_equal(got[m], got["direct"], err_msg=m)
+        np.testing.assert_allclose(got[m], want, rtol=1e-9, atol=1e-300, err_msg=m)

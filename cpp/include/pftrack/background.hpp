@@ -24,18 +24,21 @@ namespace pftrack {
 /// (max, min) only, the value bin on max only, the hue bin on (sector, numerator, max - min) only.
 class HsvLut {
 public:
-    explicit HsvLut(const HsvBinning& p) : n_s_(p.n_s), grey0_(p.n_h * p.n_s) {
+    explicit HsvLut(const HsvBinning& p) : grey0_(p.n_h * p.n_s) {
         p.validate("HsvLut");
         sat_.assign(256 * 256, 0);
+        const auto n_s = static_cast<std::uint32_t>(p.n_s);
         for (int mx = 0; mx < 256; ++mx) {
             // Same expressions as hsv_bin_of, so the same doubles and the same truncations.
             const double v = mx / 255.0;
             const int vb = std::min(static_cast<int>(v * p.n_v), p.n_v - 1);
             for (int mn = 0; mn <= mx; ++mn) {
                 const double s = mx > 0 ? static_cast<double>(mx - mn) / mx : 0.0;
-                sat_[mx * 256 + mn] = static_cast<std::int8_t>(
-                    (s > p.s_min && v > p.v_min) ? std::min(static_cast<int>(s * p.n_s), p.n_s - 1)
-                                                 : -1 - vb);
+                sat_[mx * 256 + mn] =
+                    (s > p.s_min && v > p.v_min)
+                        ? (n_s << 16) | static_cast<std::uint32_t>(
+                                            std::min(static_cast<int>(s * p.n_s), p.n_s - 1))
+                        : static_cast<std::uint32_t>(grey0_ + vb);
             }
         }
         hue_.assign(3 * kHueStride, 0);
@@ -58,9 +61,11 @@ public:
 
     /// Bin from the table indices sat = max * 256 + min and hue = sector * kHueStride + d * d +
     /// num + d (see `bin`).
+    /// Branch-free: (the saturation bin, n_s) of a colour pixel, (the grey bin, 0) of a grey
+    /// one, packed in one entry of sat_, so the bin is sat's low half + hue bin * its high half.
     int bin_at(int sat, int hue) const {
-        const int sb = sat_[static_cast<size_t>(sat)];
-        return sb >= 0 ? hue_[static_cast<size_t>(hue)] * n_s_ + sb : grey0_ - 1 - sb;
+        const std::uint32_t e = sat_[static_cast<size_t>(sat)];
+        return static_cast<int>((e & 0xffffu) + hue_[static_cast<size_t>(hue)] * (e >> 16));
     }
 
     int bin(int b, int g, int r) const {
@@ -76,10 +81,9 @@ public:
     static constexpr int kHueStride = 256 * 256;  // d * d + (num + d) < 256^2 for d < 256
 
 private:
-    int n_s_;
     int grey0_;                     // first grey bin, n_h * n_s
-    std::vector<std::int8_t> sat_;  // [max * 256 + min] -> saturation bin if a colour pixel,
-                                    // else -1 - value bin
+    std::vector<std::uint32_t> sat_;  // [max * 256 + min] -> n_s << 16 | saturation bin if a
+                                      // colour pixel, else the grey bin n_h n_s + value bin
 
     std::vector<std::uint8_t> hue_;   // [sector][d * d + num + d], d = max - min -> hue bin
 };

@@ -81,9 +81,16 @@ inline bool box_is_sane(double cx, double cy, double w, double h) {
 inline int partial_sum_of(int k, int n_bins) { return k < (n_bins & ~3) ? (k & 3) : 0; }
 
 /// Bins split by partial_sum_of: bins[q][0 .. n[q]) go to partial sum q, in increasing order.
+/// An integral histogram's box (for_each_range_count<true>) also gives its counts in compact
+/// form: counts[l] for the compact index l of each bin present, local[q][j] that of bins[q][j],
+/// bin_of_local[l] the bin of l (-1: background), n_local of them; counts is null otherwise.
 struct BinLanes {
     const std::int16_t* bins[4];
     int n[4];
+    const std::int16_t* local[4] = {nullptr, nullptr, nullptr, nullptr};
+    const std::uint16_t* counts = nullptr;
+    const std::int16_t* bin_of_local = nullptr;
+    int n_local = 0;
 };
 
 /// Scratch space for one histogram. Slot 0 collects background (bin -1) so the inner loop never
@@ -213,10 +220,51 @@ public:
         return ((r0 + r1) + (r2 + r3)) / norm;
     }
 
-private:
+    /// Takes the reference's square roots of the bins of `present` (an integral histogram's
+    /// region, compact form) for coefficient_of_compact: once per region, not per box.
+    void gather_reference(const double* sqrt_ref, const BinLanes& present) {
+        sref_local_.resize(static_cast<size_t>(present.n_local));
+        for (int l = 0; l < present.n_local; ++l) {
+            const int b = present.bin_of_local[l];
+            sref_local_[static_cast<size_t>(l)] = b >= 0 ? sqrt_ref[b] : 0.0;
+        }
+    }
+
+    /// coefficient_of_counts(c, total, sqrt_ref, present) of a box given in compact form
+    /// (present.counts, after gather_reference of the same region and reference), total <
+    /// kSqrtTableMax: the same terms tab[c_k] sqrt_ref[k], into the same partial sums in the
+    /// same order, so bit for bit the same value, read from the compact counts in place of a
+    /// copy of them scattered over every bin.
+    double coefficient_of_compact(std::int64_t total, const BinLanes& present) const {
+        if (total == 0) return 0.0;
+        const double norm = std::sqrt(static_cast<double>(total));
+        const double* tab = sqrt_table(static_cast<size_t>(total));
+        const std::uint16_t* cnt = present.counts;
+        const double* sref = sref_local_.data();
+        const auto term = [&](int l) { return tab[cnt[l]] * sref[l]; };
+        const std::int16_t *l0 = present.local[0], *l1 = present.local[1], *l2 = present.local[2],
+                           *l3 = present.local[3];
+        const int n0 = present.n[0], n1 = present.n[1], n2 = present.n[2], n3 = present.n[3];
+        const int m = std::min(std::min(n0, n1), std::min(n2, n3));
+        double r0 = 0.0, r1 = 0.0, r2 = 0.0, r3 = 0.0;
+        for (int j = 0; j < m; ++j) {
+            r0 += term(l0[j]);
+            r1 += term(l1[j]);
+            r2 += term(l2[j]);
+            r3 += term(l3[j]);
+        }
+        for (int j = m; j < n0; ++j) r0 += term(l0[j]);
+        for (int j = m; j < n1; ++j) r1 += term(l1[j]);
+        for (int j = m; j < n2; ++j) r2 += term(l2[j]);
+        for (int j = m; j < n3; ++j) r3 += term(l3[j]);
+        return ((r0 + r1) + (r2 + r3)) / norm;
+    }
+
     // Boxes of fewer pixels look sqrt(count) up in a table (110 square roots per box cost as
     // much as counting a 20x50 box's pixels); larger boxes compute them.
     static constexpr std::int64_t kSqrtTableMax = std::int64_t(1) << 16;
+
+private:
 
     /// sqrt(0 .. at_least), grown on demand (each entry exactly std::sqrt of its index). One
     /// table per thread, kept from call to call: a scratch made per object and frame filled
@@ -346,6 +394,7 @@ private:
     std::vector<double> weights_;
     std::vector<double> rowk_;
     std::vector<double> hist_;
+    std::vector<double> sref_local_;  // gather_reference: sqrt_ref of each compact bin
 };
 
 inline void check_bin_image(const BinImage& img, const char* fn) {

@@ -51,8 +51,12 @@ public:
         BinLanes l;
         for (int q = 0; q < 4; ++q) {
             l.bins[q] = lanes_.data() + lane_start_[q];
+            l.local[q] = lanes_local_.data() + lane_start_[q];
             l.n[q] = lane_start_[q + 1] - lane_start_[q];
         }
+        l.counts = local_.data();  // box_counts' compact counts (after build)
+        l.bin_of_local = bin_of_local_.data();
+        l.n_local = n_local_;
         return l;
     }
 
@@ -75,11 +79,17 @@ public:
         }
         n_local_ = static_cast<int>(bin_of_local_.size());
         lanes_.resize(bin_of_local_.size());  // present(): bins >= 0 by partial sum, in order
+        lanes_local_.resize(bin_of_local_.size());  // ... and their compact indices
         int at = 0;
         for (int q = 0; q < 4; ++q) {
             lane_start_[q] = at;
-            for (const std::int16_t b : bin_of_local_)
-                if (b >= 0 && partial_sum_of(b, n_bins_) == q) lanes_[static_cast<size_t>(at++)] = b;
+            for (int l = 0; l < n_local_; ++l) {
+                const std::int16_t b = bin_of_local_[static_cast<size_t>(l)];
+                if (b >= 0 && partial_sum_of(b, n_bins_) == q) {
+                    lanes_[static_cast<size_t>(at)] = b;
+                    lanes_local_[static_cast<size_t>(at++)] = static_cast<std::int16_t>(l);
+                }
+            }
         }
         lane_start_[4] = at;
         stride_ = (n_local_ + kLanes - 1) / kLanes * kLanes;
@@ -134,6 +144,15 @@ public:
     /// Counts of the box `r` (inside the region, at most kMaxBoxPixels pixels) written to c[bin]
     /// for each bin present in the region, c[-1] for background; other entries are left alone.
     void box_counts(const PixelRange& r, std::int32_t* c) {
+        box_counts_compact(r);
+        const std::uint16_t* out = local_.data();
+        const std::int16_t* bin = bin_of_local_.data();
+        for (int k = 0; k < n_local_; ++k) c[bin[k]] = out[k];
+    }
+
+    /// Counts of the box `r` (as box_counts) in compact form only, into present().counts;
+    /// returns its background pixels (bin -1).
+    std::int64_t box_counts_compact(const PixelRange& r) {
         const Index x0 = r.x0 - region_.x0, x1 = r.x1 - region_.x0;
         const Index y0 = r.y0 - region_.y0, y1 = r.y1 - region_.y0;
         const std::uint16_t* t = table_.get();
@@ -155,8 +174,7 @@ public:
         for (int k = 0; k < stride_; ++k)
             out[k] = static_cast<std::uint16_t>(e[k] - b[k] - d[k] + a[k]);  // mod 2^16: exact
 #endif
-        const std::int16_t* bin = bin_of_local_.data();
-        for (int k = 0; k < n_local_; ++k) c[bin[k]] = out[k];
+        return n_local_ > 0 && bin_of_local_[0] < 0 ? out[0] : 0;  // background: compact 0
     }
 
 private:
@@ -235,10 +253,16 @@ private:
     std::vector<std::uint8_t> seen_;         // bin + 1 -> present in the region
     std::vector<std::int16_t> bin_of_local_;  // compact index -> bin (-1: background)
     std::vector<std::int16_t> lanes_;        // the bins >= 0 present, by partial sum (present())
+    std::vector<std::int16_t> lanes_local_;  // their compact indices
     std::unique_ptr<std::uint16_t[]> table_;  // (h + 1) x (w + 1) x stride_ (of a larger buffer)
     size_t table_capacity_ = 0;
     std::vector<std::uint16_t> local_;       // one box's (or one row's running) compact counts
 };
+
+// The compact coefficients (for_each_range_count<true>) look every square root up: no box
+// counted from a table reaches the table's end.
+static_assert(IntegralHistogram::kMaxBoxPixels < HistogramScratch::kSqrtTableMax,
+              "coefficient_of_compact needs every table-counted box under kSqrtTableMax pixels");
 
 /// Cost model of one group, in ns on the development machine (a least-squares fit over boxes of
 /// 4x4 to 60x150 pixels, 1 to 256 boxes, PETS and noise frames; docs/kernels.md). Both include
@@ -268,10 +292,12 @@ struct BoxCostModel {
 /// Calls `from_counts(i, c, total, present)` with box i's counts c[0 .. n_bins) (c[-1]:
 /// background; 0 but for the bins `present`, BinLanes) and counted pixels for boxes
 /// counted from a table, and `direct(i, r)` with the clipped pixel
-/// range of every other box (empty ones included). Scratch is local to the call, but for the
+/// range of every other box (empty ones included). With kCompact, `from_counts(i, total,
+/// present, first)` instead, the counts in compact form only (present.counts; `first` for the
+/// first box of each table, whose bins present then change). Scratch is local to the call, but for the
 /// table: `shared_table`, the caller's to reuse (for img.n_bins bins), else a local one.
 /// for_each_box_count of boxes given as clipped pixel ranges of `img` (as box_pixels gives).
-template <class FromCounts, class Direct>
+template <bool kCompact = false, class FromCounts, class Direct>
 inline void for_each_range_count(const BinImage& img, const std::vector<PixelRange>& ranges,
                                  BoxPath path, FromCounts&& from_counts, Direct&& direct,
                                  IntegralHistogram* shared_table = nullptr) {
@@ -375,19 +401,28 @@ inline void for_each_range_count(const BinImage& img, const std::vector<PixelRan
         }
         table.build(img);
         present = table.present();
-        std::fill(counts.begin(), counts.end(), 0);  // bins absent from the region stay 0
-        for (const Index* m = m0; m != m1; ++m) {
-            const PixelRange& r = ranges[static_cast<size_t>(*m)];
-            table.box_counts(r, c);
-            from_counts(*m, static_cast<const std::int32_t*>(c), pixel_count(r) - c[-1],
-                        present);
+        if constexpr (kCompact) {
+            // no copy over every bin: from_counts(i, total, present, first box of the region)
+            for (const Index* m = m0; m != m1; ++m) {
+                const PixelRange& r = ranges[static_cast<size_t>(*m)];
+                const std::int64_t background = table.box_counts_compact(r);
+                from_counts(*m, pixel_count(r) - background, present, m == m0);
+            }
+        } else {
+            std::fill(counts.begin(), counts.end(), 0);  // bins absent from the region stay 0
+            for (const Index* m = m0; m != m1; ++m) {
+                const PixelRange& r = ranges[static_cast<size_t>(*m)];
+                table.box_counts(r, c);
+                from_counts(*m, static_cast<const std::int32_t*>(c), pixel_count(r) - c[-1],
+                            present);
+            }
         }
     }
 }
 
 /// Uniform-kernel counts of K boxes (rows (cx, cy, w, h)): for_each_range_count of their
 /// clipped pixel ranges.
-template <class Derived, class FromCounts, class Direct>
+template <bool kCompact = false, class Derived, class FromCounts, class Direct>
 inline void for_each_box_count(const BinImage& img, const Eigen::MatrixBase<Derived>& boxes,
                                BoxPath path, FromCounts&& from_counts, Direct&& direct,
                                IntegralHistogram* shared_table = nullptr) {
@@ -395,7 +430,7 @@ inline void for_each_box_count(const BinImage& img, const Eigen::MatrixBase<Deri
     for (Index i = 0; i < boxes.rows(); ++i)
         ranges[static_cast<size_t>(i)] =
             box_pixels(boxes(i, 0), boxes(i, 1), boxes(i, 2), boxes(i, 3), img.rows, img.cols);
-    for_each_range_count(img, ranges, path, std::forward<FromCounts>(from_counts),
+    for_each_range_count<kCompact>(img, ranges, path, std::forward<FromCounts>(from_counts),
                          std::forward<Direct>(direct), shared_table);
 }
 
@@ -482,11 +517,12 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
             }
             return;
         }
-        for_each_range_count(
+        for_each_range_count<true>(
             points, ranges, path,
-            [&](Index i, const std::int32_t* c, std::int64_t total, const BinLanes& present) {
+            [&](Index i, std::int64_t total, const BinLanes& present, bool first) {
+                if (first) scratch.gather_reference(sqrt_ref, present);
                 counted[i] = static_cast<double>(total) * area;
-                rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref, present);
+                rho[i] = scratch.coefficient_of_compact(total, present);
             },
             [&](Index i, const PixelRange& r) {
                 rho[i] = scratch.coefficient_of_range(points, r, sqrt_ref, counted[i]);
@@ -501,11 +537,12 @@ inline void box_coefficients(const BinImage& img, const Eigen::MatrixBase<Derive
                                          kernel, sqrt_ref, counted[i]);
         return;
     }
-    for_each_box_count(
+    for_each_box_count<true>(
         img, boxes, path,
-        [&](Index i, const std::int32_t* c, std::int64_t total, const BinLanes& present) {
+        [&](Index i, std::int64_t total, const BinLanes& present, bool first) {
+            if (first) scratch.gather_reference(sqrt_ref, present);
             counted[i] = static_cast<double>(total);
-            rho[i] = scratch.coefficient_of_counts(c, total, sqrt_ref, present);
+            rho[i] = scratch.coefficient_of_compact(total, present);
         },
         [&](Index i, const PixelRange& r) {
             rho[i] = scratch.coefficient_of_range(img, r, sqrt_ref, counted[i]);
