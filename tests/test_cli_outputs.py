@@ -134,6 +134,12 @@ def _bad_output(case: str, command: str, inputs: dict[str, Path], tmp: Path) -> 
         if command not in GOOD_NAME:
             pytest.skip("text outputs take any extension")
         return tmp / "out.xyz"
+    if case in ("a video", "a picture"):  # was: the video replaced by text, exit 0
+        if command in GOOD_NAME:
+            pytest.skip("media outputs: their extension is checked (covered above)")
+        name = "annotated.mp4" if case == "a video" else "paths.png"
+        (tmp / name).write_bytes(b"\x00\x00\x00\x18ftypmp42\x00 a user's video or picture")
+        return tmp / name
     if case == "an input":
         key = "gt" if command == "eval --json" else "tracks"
         if command.startswith("track"):
@@ -145,11 +151,15 @@ def _bad_output(case: str, command: str, inputs: dict[str, Path], tmp: Path) -> 
 
 
 CASES = ["existing folder", "missing folder", "unwritable folder", "unsupported extension",
-         "an input", "new folder with a trailing slash", "-", "empty", "under a file"]  # fmt: skip
+         "an input", "new folder with a trailing slash", "-", "empty", "under a file", "a video",
+         "a picture"]  # fmt: skip
 #: The whole message of a case, after ``pftrack CMD: error: `` (OPTION, OUT, TMP filled in).
 MESSAGES = {
     "empty": "{option} is empty; give a file name",
     "under a file": "{option} {out}: {tmp}/t_ok.txt is a file, not a folder",
+    "a video": "{option} {out} is an existing file that is not text (a video? a picture?), and "
+    "{option} writes the tracks as MOTChallenge text over it: give a .txt name (--render and "
+    "pftrack render write videos, --plot pictures)",
 }
 
 

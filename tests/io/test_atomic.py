@@ -784,3 +784,21 @@ def test_a_ctrl_c_outside_the_console_script_is_not_remembered(tmp_path: Path) -
     assert not _interrupt.interrupted()
     write_mot(tmp_path / "t.txt", [[1, 1, 0, 0, 10, 10]])
     assert (tmp_path / "t.txt").exists()
+
+
+def test_a_tracks_file_does_not_replace_a_file_that_is_not_text(tmp_path: Path) -> None:
+    """``check_output(tracks=True)`` refuses an existing binary file, under any name."""
+    from pftrack.io.atomic import check_output
+
+    video = tmp_path / "annotated.mp4"
+    video.write_bytes(b"\x00\x00\x00\x18ftypisom" + bytes(range(256)))
+    link = tmp_path / "tracks.txt"
+    link.symlink_to(video)  # refused where it leads
+    for out in (video, link):
+        with pytest.raises(ValueError, match="is an existing file that is not text"):
+            check_output(out, what="--out", tracks=True)
+    check_output(video, what="--render")  # not a tracks file: replaced, as before
+    text = tmp_path / "old.mp4"
+    text.write_text("1,1,10,20,30,40,1,-1,-1,-1\n")  # text: replaced, whatever its name
+    check_output(text, what="--out", tracks=True)
+    check_output(tmp_path / "new.png", what="--out", tracks=True)  # none there yet

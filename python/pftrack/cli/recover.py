@@ -97,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
         from pftrack.io.video import source_files  # OpenCV: only with a video
 
         inputs = tuple(source_files(args.video))
-    check_output(args.out, what="--out", inputs=inputs)
+    check_output(args.out, what="--out", inputs=inputs, tracks=True)
     if args.video:  # an image --out beside its frames: one more frame of the next run
         from pftrack.io.video import check_outside_frames
 

@@ -63,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
     src, out = Path(args.tracks), Path(args.out)
     if out.exists() and src.exists() and os.path.samefile(out, src):
         raise ValueError(f"--out {out} is the input file; write the result elsewhere")
-    check_output(args.out, what="--out")
+    check_output(args.out, what="--out", tracks=True)
     rows = read_tracks(src)
     link = None if args.no_link else link_config_for(rows, args.max_gap, args.max_distance)
     result = smooth_tracks(rows, link=link, max_gap=args.max_gap)

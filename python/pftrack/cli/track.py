@@ -246,7 +246,7 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
             seq = find_sequence(args.source)
             found = seq.detections if seq is not None else None
             inputs += (found,) if found is not None else ()
-    check_output(args.out, what="--out", inputs=inputs)
+    check_output(args.out, what="--out", inputs=inputs, tracks=True)
     if args.render is not None:  # "" too: refused as empty (was: no video, without a word)
         check_output(args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs)
     if args.plot is not None:

@@ -794,6 +794,7 @@ def check_output(
     suffixes: tuple[str, ...] | None = None,
     inputs: tuple[PathLike, ...] = (),
     within: PathLike | None = None,
+    tracks: bool = False,
 ) -> Path:
     """Check, before any work, that `path` can be written; return it as a :class:`Path`.
 
@@ -811,11 +812,18 @@ def check_output(
         The output folder `what` names, when `path` is a file the command names in it
         (``pftrack demo --out-dir DIR``'s ``DIR/tracks.txt``): a folder in the way is then
         blamed on the path inside `within`, not taken for the user's file name.
+    tracks : bool
+        Whether `path` takes a tracks file (MOTChallenge text: ``--out`` of ``pftrack track``,
+        ``recover`` and ``smooth``): an existing file there that is not text (NUL bytes in its
+        first 8 KiB: a video, a picture) is then refused, so that ``--out annotated.mp4``
+        typed for ``--render annotated.mp4`` does not replace the video with text (was:
+        replaced without a word). A text file is replaced, as any output is.
 
     Raises
     ------
     ValueError
-        The path is empty; the extension is not supported; the path is a folder, or can only
+        The path is empty; the extension is not supported; for a tracks file (`tracks`), an
+        existing file that is not text; the path is a folder, or can only
         name one (a trailing slash: ``newdir/``); it is ``-`` (standard output: give
         ``/dev/stdout``); or it names an input.
     FileNotFoundError
@@ -862,7 +870,24 @@ def check_output(
         _check_folder(written, what, target)
     if _one_of(target, inputs):
         raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
+    if tracks and not resolved.through:
+        _refuse_binary(written, what, text)
     return target
+
+
+def _refuse_binary(written: Path, what: str, text: str) -> None:
+    """Refuse to replace an existing file that is not text with tracks (:func:`check_output`)."""
+    try:
+        with open(written, "rb") as f:
+            head = f.read(8192)
+    except OSError:  # none there yet (or unreadable: the write says so)
+        return
+    if b"\0" in head:
+        raise ValueError(
+            f"{what} {text} is an existing file that is not text (a video? a picture?), and "
+            f"{what} writes the tracks as MOTChallenge text over it: give a .txt name "
+            "(--render and pftrack render write videos, --plot pictures)"
+        )
 
 
 def _one_of(target: Path, files: Iterable[PathLike]) -> bool:
