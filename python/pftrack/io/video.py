@@ -1006,8 +1006,9 @@ def _frame_list(indexes: list[int]) -> str:
     return f"frame{'s' * (len(indexes) > 1)} {text}"
 
 
-def video_files(folder: Path) -> list[Path]:
+def video_files(folder: PathLike) -> list[Path]:
     """The video files (:data:`VIDEO_SUFFIXES`) directly in `folder`, in natural order."""
+    folder = Path(path_arg(folder, "video_files: folder"))  # was: an AttributeError for a str
     return sorted(
         (p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in VIDEO_SUFFIXES),
         key=lambda p: natural_key(p.name),
@@ -1607,13 +1608,14 @@ def _unreadable(path: Path, notes: Sequence[str]) -> _Unreadable:
     return _Unreadable(path, why)
 
 
-def image_files(folder: Path) -> list[Path]:
+def image_files(folder: PathLike) -> list[Path]:
     """The image files (:data:`IMAGE_SUFFIXES`) directly in `folder`, in no particular order.
 
     Hidden files (names starting with a point) are left out, as ``ls`` leaves them: macOS's
     ``._000001.jpg`` beside each image of a folder copied from its disks, a viewer's
     ``.thumb.jpg`` (were: frames, or an image that could not be read; a user trial).
     """
+    folder = Path(path_arg(folder, "image_files: folder"))  # was: an AttributeError for a str
     return [p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.name[0] != "."]
 
 
