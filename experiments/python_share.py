@@ -126,7 +126,9 @@ def one_round(
 
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(
-        prog="python -m experiments.python_share", description=__doc__.splitlines()[0]
+        prog="python -m experiments.python_share",
+        description=__doc__.splitlines()[0],
+        allow_abbrev=False,
     )
     ap.add_argument("--rounds", type=int, default=7, help="rounds per case (default 7)")
     args = ap.parse_args(argv)

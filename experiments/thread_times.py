@@ -188,6 +188,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m experiments.thread_times",
         description="Per-thread wall time of the parts of a `pftrack -q track` run.",
+        allow_abbrev=False,
     )
     parser.add_argument("source", help="the video (or image folder) to track")
     parser.add_argument("--out", help="the track file (default: a temporary file, removed)")

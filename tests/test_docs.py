@@ -1,16 +1,27 @@
 """README.md and docs/*.md as a reader follows them: every relative link and #anchor lands, the
 set-up commands are the ones CI runs, every ``pftrack`` command of the README's bash blocks is
-one the parser takes with its options spelt in full, and the Goals table keeps short cells.
+one the parser takes with its options spelt in full, every `pftrack ...` and `python -m
+experiments.X ...` quoted anywhere in them names a command, module and options that exist, and
+the Goals table keeps short cells.
 
 The README's Python blocks are run by tests/test_api.py and tests/tracking/test_api_tracker.py.
 """
 
 from __future__ import annotations
 
+import argparse
+import contextlib
+import functools
+import importlib
+import importlib.util
+import inspect
+import io
 import re
 import shlex
+import sys
 from collections.abc import Iterator
 from pathlib import Path
+from typing import NoReturn
 
 import pytest
 
@@ -173,3 +184,158 @@ def test_every_readme_pftrack_command_parses(
     usage = capsys.readouterr().out
     for option in (a.split("=")[0] for a in argv if a.startswith("--")):
         assert re.search(rf"{option}\b(?!-)", usage), f"{option} is not spelt as in --help"
+
+
+def _quoted_commands(docs: list[Path] = DOCS) -> list[tuple[str, list[str], bool]]:
+    """``(doc:line, argv, whole)`` of each ``pftrack ...`` and ``python -m experiments.X ...``
+    quoted in README.md and docs/*.md: in a bash block (`whole`: a command as typed, every
+    argument it needs), or in a plain block or `code span` of the prose (often a synopsis or
+    a part: ``pftrack track --render``). `argv` starts at ``pftrack`` or ``experiments.X``; a
+    ``NAME`` or ``CMD`` and an error line quoted (``pftrack track: error: ...``) are left out.
+    """
+    found = []
+    for doc in docs:
+        name = doc.relative_to(doc.parents[1] if doc.parent.name == "docs" else doc.parent)
+        name = name.as_posix()
+        text = doc.read_text(encoding="utf-8").replace("\\\n", " ")
+        places: list[tuple[int, str, bool]] = []
+        fence = None  # the open block's language
+        for number, line in enumerate(text.splitlines(), start=1):
+            if line.startswith("```"):
+                fence = line[3:].strip() if fence is None else None
+            elif fence in ("bash", ""):  # a plain block: synopses ([--scale S]), output
+                places.append((number, line, fence == "bash"))
+            elif fence is None:
+                places += [(number, m.group(1), False) for m in re.finditer(r"`([^`]+)`", line)]
+        for number, code, whole in places:
+            for part in re.split(r"\s(?:;|&&|\|)\s", code):
+                try:
+                    argv = shlex.split(part, comments=True)
+                except ValueError:
+                    continue
+                while argv and re.fullmatch(r"[A-Z_]+=\S*|\$|/usr/bin/time|-v", argv[0]):
+                    argv = argv[1:]  # PFTRACK_DATA=... cmd, $ cmd, /usr/bin/time -v cmd
+                if argv[:3] in (["python", "-m", "pftrack"], ["python", "-m", "pftrack.cli"]):
+                    argv = ["pftrack", *argv[3:]]
+                elif argv[:2] == ["python", "-m"] and argv[2:3]:
+                    argv = argv[2:]
+                if not argv or not re.fullmatch(r"pftrack|experiments\.[a-z_]+", argv[0]):
+                    continue
+                words = [w for w in argv[1:] if not w.startswith("-")][:2]
+                if any(w.endswith(":") or w.isupper() for w in words):
+                    continue  # an error line (pftrack experiment gaps: ...), or CMD
+                found.append((f"{name}:{number}", argv, whole))
+    return found
+
+
+@functools.cache
+def _experiment_parser(module: str) -> argparse.ArgumentParser:
+    """The parser ``python -m experiments.X`` builds: its ``main`` is run up to its parse
+    (once a module: parsing leaves a parser as it was)."""
+
+    class _Built(Exception):
+        pass
+
+    seen: list[argparse.ArgumentParser] = []
+
+    def built(self: argparse.ArgumentParser, *args: object, **kwargs: object) -> NoReturn:
+        seen.append(self)
+        raise _Built
+
+    main = importlib.import_module(module).main
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(argparse.ArgumentParser, "parse_known_args", built)
+        patch.setattr(sys, "argv", [module])
+        with pytest.raises(_Built):
+            main(*([[]] if inspect.signature(main).parameters else []))
+    return seen[0]
+
+
+def _options_taken(parser: argparse.ArgumentParser, argv: list[str]) -> list[str]:
+    """Each option of `argv` (after the command's name) its (sub-)command does not take,
+    spelt in full: ``--ren`` of ``pftrack track``, a sub-command that does not exist."""
+    bad = []
+    for word in argv:
+        subs = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+        option = word.strip("[]").split("=")[0]
+        if re.fullmatch(r"--?[A-Za-z][\w-]*", option):
+            if option not in parser._option_string_actions:
+                bad.append(f"{option} (not an option of {parser.prog})")
+        elif subs and not word.startswith("-"):
+            if word not in subs[0].choices:
+                bad.append(f"{word} (not a command of {parser.prog})")
+                break
+            parser = subs[0].choices[word]
+    return bad
+
+
+QUOTED = _quoted_commands()
+_PFTRACK = build_parser()  # one for every quoted command: parsing leaves it as it was
+
+
+def test_the_command_checker_finds_a_wrong_command_and_option(
+    tmp_path: Path,
+) -> None:
+    (tmp_path / "docs").mkdir()
+    doc = tmp_path / "docs" / "a.md"
+    doc.write_text(
+        "Run `pftrack track v.mp4 --ren r.mp4` or `pftrack trak` (`pftrack track: error: x`,\n"
+        "`pftrack --quiet CMD`), `python -m experiments.auto_seeds --seed 2` or\n"
+        "`PFTRACK_DATA=d python -m experiments.NAME --help`:\n"
+        "```bash\npftrack experiment gaps --gt a.txt \\\n  --n-masks 6 && pftrack eval --gt g\n"
+        "```\n"
+    )
+    quoted = _quoted_commands([doc])
+    assert [(place, " ".join(argv), whole) for place, argv, whole in quoted] == [
+        ("docs/a.md:1", "pftrack track v.mp4 --ren r.mp4", False),
+        ("docs/a.md:1", "pftrack trak", False),
+        ("docs/a.md:2", "experiments.auto_seeds --seed 2", False),
+        ("docs/a.md:5", "pftrack experiment gaps --gt a.txt --n-masks 6", True),
+        ("docs/a.md:5", "pftrack eval --gt g", True),
+    ]
+    taken = [
+        _options_taken(build_parser(), argv[1:]) for _, argv, _ in quoted if argv[0] == "pftrack"
+    ]
+    assert taken == [
+        ["--ren (not an option of pftrack track)"],
+        ["trak (not a command of pftrack)"],
+        [],
+        [],
+    ]
+    seeds = _experiment_parser("experiments.auto_seeds")
+    assert _options_taken(seeds, ["--seed", "2"]) == [
+        "--seed (not an option of python -m experiments.auto_seeds)"
+    ]
+    with pytest.raises(SystemExit):  # a whole command: --res is required
+        build_parser().parse_args(quoted[-1][1][1:])
+
+
+def test_the_docs_quote_commands_of_both_kinds() -> None:
+    kinds = {argv[0].partition(".")[0] for _, argv, _ in QUOTED}
+    assert kinds == {"pftrack", "experiments"}
+    assert len(QUOTED) > 300 and sum(whole for *_, whole in QUOTED) >= 40
+
+
+def test_every_quoted_command_names_what_its_parser_takes() -> None:
+    """Each ``pftrack ...`` and ``python -m experiments.X ...`` of README.md and docs/*.md
+    names a command or module that exists and options its parser takes, spelt in full; one
+    of a bash block parses as a whole (the real parser; nothing runs). One test for the 537,
+    each wrong one listed: a test each took about 40 s more of CI on this machine."""
+    wrong = []
+    for place, argv, whole in QUOTED:
+        if argv[0] == "pftrack":
+            parser = _PFTRACK
+        elif importlib.util.find_spec(argv[0]) is None:
+            wrong.append(f"{place}: no module {argv[0]}")
+            continue
+        else:
+            parser = _experiment_parser(argv[0])
+        wrong += [f"{place}: {problem}" for problem in _options_taken(parser, argv[1:])]
+        if whole and "--help" not in argv:
+            said = io.StringIO()
+            try:
+                with contextlib.redirect_stderr(said):
+                    parser.parse_args(argv[1:])
+            except SystemExit:
+                wrong.append(f"{place}: {' '.join(argv)}: {said.getvalue().strip()}")
+    assert wrong == []

@@ -111,9 +111,9 @@ class BackgroundModel:
     @property
     def n_bins(self) -> int: ...
     @property
-    def shape(self) -> Any: ...  # (H, W), or None before the first frame
+    def shape(self) -> tuple[int, int] | None: ...  # (H, W), or None before the first frame
     @property
-    def background(self) -> Any: ...  # (H, W, 3) float32, or None before the first frame
+    def background(self) -> NDArray[np.float32] | None: ...  # (H, W, 3) BGR copy, or None before
     @property
     def difference_histogram(self) -> NDArray[np.int64]: ...  # (256,) int64
     @property

@@ -20,7 +20,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import brief, flag, generator, number, option, real
+from pftrack._check import brief, flag, generator, instance, number, option, real, shown
 from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
@@ -524,8 +524,36 @@ def camera_path(
     return out
 
 
+def _affines(value: object, what: str, shape: tuple[int, ...]) -> NDArray[np.float64]:
+    """`value` as a finite float64 array of `shape` (-1: any length), or TypeError/ValueError."""
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"{what} must be an array of numbers, got {shown(value)}") from None
+    if a.ndim != len(shape) or any(n not in (-1, m) for n, m in zip(shape, a.shape, strict=True)):
+        expected = ", ".join("T" if n == -1 else str(n) for n in shape)
+        raise ValueError(f"{what} has shape {a.shape}, expected ({expected})")
+    if not np.isfinite(a).all():
+        raise ValueError(f"{what} has a value that is NaN or inf")
+    return a
+
+
 def warp_frame(frame: NDArray[np.uint8], affine: NDArray[np.float64]) -> NDArray[np.uint8]:
-    """Frame `frame` seen through `affine` (source to image, same size; bilinear)."""
+    """Frame `frame` seen through `affine` (source to image, same size; bilinear).
+
+    Raises
+    ------
+    TypeError
+        If `frame` is not an array (was: an AttributeError), or `affine` not one of numbers.
+    ValueError
+        If `frame` is not an (H, W) or (H, W, C) image, or `affine` not a finite (2, 3) matrix
+        (were: OpenCV's assertion, in several lines).
+    """
+    if not isinstance(frame, np.ndarray):
+        raise TypeError(f"warp_frame: frame must be an (H, W, 3) array, got {shown(frame)}")
+    if frame.ndim not in (2, 3) or frame.shape[0] == 0 or frame.shape[1] == 0:
+        raise ValueError(f"warp_frame: frame has shape {frame.shape}, expected (H, W, 3)")
+    affine = _affines(affine, "warp_frame: affine", (2, 3))
     h, w = frame.shape[:2]
     out = cv2.warpAffine(
         frame, affine, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT
@@ -558,7 +586,15 @@ def warp_rows(
     min_visible : float
         Share of a box that must stay inside the image.
     """
-    r = np.array(rows, dtype=np.float64, copy=True).reshape(-1, np.shape(rows)[-1])
+    if not isinstance(rows, (np.ndarray, list, tuple)):
+        raise TypeError(f"warp_rows: rows must be an (M, 10) array, got {shown(rows)}")
+    shape = np.shape(rows)
+    if len(shape) not in (1, 2) or shape[-1] < 6:  # was: NumPy's IndexError
+        raise ValueError(f"warp_rows: rows has shape {shape}, expected (M, 6..10)")
+    affines = _affines(affines, "warp_rows: affines", (-1, 2, 3))
+    if not isinstance(size, (tuple, list)) or len(size) != 2:
+        raise TypeError(f"warp_rows: size must be (height, width), got {shown(size)}")
+    r = np.array(rows, dtype=np.float64, copy=True).reshape(-1, shape[-1])
     f = r[:, 0].astype(np.int64) - 1
     r = r[(f >= 0) & (f < len(affines))]
     a = affines[r[:, 0].astype(np.int64) - 1]
@@ -582,6 +618,7 @@ def move_camera(scene: Scene, **path: Any) -> Scene:
     Frames and ground truth are warped; the background is the first frame's view and the
     occluder is dropped (it moves with the view).
     """
+    instance(scene, "move_camera: scene", Scene)  # was: an AttributeError
     affines = camera_path(len(scene.frames), (scene.height, scene.width), **path)
     return Scene(
         frames=[warp_frame(f, a) for f, a in zip(scene.frames, affines, strict=True)],

@@ -895,18 +895,25 @@ def test_a_truncated_sequence_video_names_its_header_and_seqlength(tmp_path: Pat
 
 
 @pytest.mark.parametrize("suffix", [".png", ".bmp"])
-def test_an_image_of_another_size_in_a_folder_is_named(tmp_path: Path, suffix: str) -> None:
-    """A PNG or JPEG when the folder is opened (its header: tests/io/test_image_sizes.py),
-    another format (BMP) when it is read."""
+@pytest.mark.parametrize("header", [True, False], ids=["header", "no-header"])
+def test_an_image_of_another_size_in_a_folder_is_named(
+    tmp_path: Path, suffix: str, header: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Refused when the folder is opened, from the images' headers (every format of
+    IMAGE_SUFFIXES: tests/io/test_image_sizes.py); where no header could be read (a damaged
+    one, here made so), when the odd image is read."""
+    import pftrack.io.video as video
+
     rng = np.random.default_rng(1)
     for k in range(1, 6):
         shape = (60, 80, 3) if k == 4 else (48, 64, 3)
         cv2.imwrite(str(tmp_path / f"{k}{suffix}"), rng.integers(0, 256, shape, dtype=np.uint8))
     message = rf"image .*4{suffix} is 80x60 but 1{suffix} is 64x48: every image of a folder must"
-    if suffix == ".png":
+    if header:
         with pytest.raises(ValueError, match=message):
             FrameSource(tmp_path)
         return
+    monkeypatch.setattr(video, "_header_size", lambda path: None)
     src = FrameSource(tmp_path)
     with pytest.raises(ValueError, match=message):
         list(src)

@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple
 
-from pftrack._check import brief, flag, shown
+from pftrack._check import brief, flag, path_arg, shown
 from pftrack._interrupt import raise_if_interrupted, written_anyway
 from pftrack._progress import Bar, enabled, progress, quiet, set_quiet
 from pftrack._text import counted, listed, listed_compactly, said_alike
@@ -1277,8 +1277,11 @@ def fingerprint(paths: Sequence[Path]) -> list[dict[str, Any]]:
         before it do not see); ``missing`` when it cannot be read (the task then fails on its
         own).
     """
+    if isinstance(paths, (str, bytes, os.PathLike)) or not isinstance(paths, Iterable):
+        raise TypeError(f"fingerprint: paths must be a sequence of paths, got {shown(paths)}")
     out: list[dict[str, Any]] = []
-    for path in paths:
+    for i, given in enumerate(paths):
+        path = Path(path_arg(given, f"fingerprint: paths[{i}]"))  # was: an AttributeError
         entry: dict[str, Any] = {"path": str(path)}
         try:
             st = path.stat()

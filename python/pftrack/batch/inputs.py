@@ -112,9 +112,7 @@ def _absolute(inputs: Inputs, hint: str = "") -> list[Path]:
         if isinstance(p, bytes):
             p = os.fsdecode(p)
         if not isinstance(p, (str, os.PathLike)):
-            raise TypeError(
-                f"inputs[{i}] must be a path (str or os.PathLike), got {type(p).__name__} {p!r}"
-            )
+            raise TypeError(f"inputs[{i}] must be a path (str or os.PathLike), got {shown(p)}")
         given.append(p)
     if not given:
         raise ValueError("no input given")

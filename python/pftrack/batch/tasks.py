@@ -367,6 +367,8 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     from pftrack.recovery.linking import check_scored_ids
     from pftrack.tracking.run import SeqinfoScale, track_path
 
+    instance(seq, "track_sequence: seq", SequenceInput)  # was: an AttributeError, at its use
+    instance(options, "track_sequence: options", TrackOptions)
     cpu = time.process_time()
     report, stop = running_task()
     missing = missing_detections(seq, options)  # first: the batch refuses it on the client
@@ -568,6 +570,7 @@ def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
     from pftrack.recovery.fill import copied_values
     from pftrack.recovery.linking import link_config_for
 
+    instance(options, "recover_file: options", RecoverOptions)  # was: an AttributeError, later
     rows = read_tracks(path)
     n_links = 0
     if options.link:
@@ -626,6 +629,7 @@ def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
     from pftrack.tracking import smooth_tracks
     from pftrack.tracking.offline import smoothed_copies
 
+    instance(options, "smooth_file: options", SmoothOptions)  # was: an AttributeError, later
     t0 = time.perf_counter()
     rows = read_tracks(path)
     link = link_config_for(rows, options.max_gap, options.max_distance) if options.link else None

@@ -63,8 +63,14 @@ class Parser(argparse.ArgumentParser):
 
     argparse prints the command's whole usage before the error line; ``--help`` still shows
     it. Sub-commands' parsers are of this class too (``add_subparsers`` makes them of the
-    parser's own class).
+    parser's own class). Long options are taken only as spelt in full (``allow_abbrev=False``,
+    here for every parser and sub-command's): ``--ren out.mp4`` was taken for ``--render``,
+    silently, and an option added later could change what an abbreviation means.
     """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
         """Print ``PROG: error: MESSAGE`` and exit with status 2.
@@ -73,6 +79,14 @@ class Parser(argparse.ArgumentParser):
         is named with the way to give it (was: ``the following arguments are required:
         source``, of a source given).
         """
+        unknown = self._unknown_options()
+        if unknown:  # said first: argparse checks required arguments before unknown ones
+            name = unknown[0]
+            if not message.startswith("unrecognized arguments"):
+                message = f"unrecognized arguments: {' '.join(unknown)}; {message}"
+            full = sorted(o for o in self._option_string_actions if o.startswith(name))
+            if full:  # was: taken for it, silently (argparse's allow_abbrev)
+                message += f" ({name} is not taken for {' or '.join(full)}: spell options in full)"
         dashed = [a for a in _ARGV.get() if a.startswith("-") and a != "-" and os.path.lexists(a)]
         if dashed:
             message += (
@@ -80,6 +94,19 @@ class Parser(argparse.ArgumentParser):
                 "after -- at the end)"
             )
         self.exit(2, f"{self.prog}: error: {message}\n")
+
+    def _unknown_options(self) -> list[str]:
+        """The long options of :func:`main`'s arguments this command's parser does not take.
+
+        Only for a parser without sub-commands (a command's, not ``pftrack``'s own).
+        """
+        if any(isinstance(a, argparse._SubParsersAction) for a in self._actions):
+            return []
+        return [
+            a.split("=")[0]
+            for a in _ARGV.get()
+            if a.startswith("--") and a.split("=")[0] not in self._option_string_actions
+        ]
 
     def _print_message(self, message: str, file: SupportsWrite[str] | None = None) -> None:
         """Print help, usage or the version; a failed write says so, as commands' output does.

@@ -34,7 +34,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack._check import shown
 from pftrack._stats import median, percentile
+from pftrack.detection.base import check_frame
 
 __all__ = [
     "BLANK_LEVELS",
@@ -70,6 +72,8 @@ def sample_step(shape: tuple[int, ...], base: int = GREY_SAMPLE_STEP) -> int:
     every 7th row and column (0.45 ms of ``BackgroundModel.global_gain`` a frame at step 4, a
     third of that at 7), with as many samples for the medians as a 640x480 one.
     """
+    if not isinstance(shape, tuple) or len(shape) < 2:  # was: an IndexError, or a TypeError's
+        raise TypeError(f"sample_step: shape must be a frame's (H, W, 3), got {shown(shape)}")
     pixels = int(shape[0]) * int(shape[1])
     return max(base, round(base * math.sqrt(pixels / _STEP_PIXELS)))
 
@@ -90,6 +94,7 @@ def is_dark(frame: NDArray[np.uint8], step: int | None = None) -> bool:
     step : int, optional
         Sampling step in rows and columns (default: :func:`sample_step` of the frame).
     """
+    frame = check_frame(frame, "is_dark")  # was: an AttributeError of None, text, a number
     step = sample_step(frame.shape) if step is None else step
     return float(frame[::step, ::step].mean()) <= DARK_LEVEL
 
@@ -111,6 +116,7 @@ def is_blank(frame: NDArray[np.uint8]) -> bool:
     frame : (H, W, 3) ndarray of uint8
         A BGR frame.
     """
+    frame = check_frame(frame, "is_blank")
     return int(frame.max()) - int(frame.min()) <= BLANK_LEVELS
 
 
@@ -132,6 +138,7 @@ def channel_spread(frame: NDArray[np.uint8], step: int | None = None) -> NDArray
     -------
     (K,) ndarray of int16
     """
+    frame = check_frame(frame, "channel_spread")
     step = sample_step(frame.shape) if step is None else step
     px = np.asarray(frame[::step, ::step], np.int16).reshape(-1, 3)
     return np.asarray(px.max(axis=1) - px.min(axis=1), np.int16)
@@ -200,6 +207,12 @@ def frame_gain(
     -------
     float
     """
+    frame = check_frame(frame, "frame_gain")
+    if not isinstance(reference, np.ndarray) or reference.shape != frame.shape:
+        raise (ValueError if isinstance(reference, np.ndarray) else TypeError)(
+            f"frame_gain: reference must be an array of the frame's shape {frame.shape}, got "
+            f"{shown(reference) if not isinstance(reference, np.ndarray) else reference.shape}"
+        )
     step = sample_step(frame.shape) if step is None else step
     sr = _pixel_sums(reference[::step, ::step])
     si = _pixel_sums(frame[::step, ::step])

@@ -30,6 +30,7 @@ from pftrack._check import (
     frames_from_1,
     mot_rows,
     path_arg,
+    shown,
 )
 from pftrack._typing import F64, PathLike
 from pftrack._warn import warn
@@ -719,9 +720,23 @@ def write_mot(
 
 
 def group_by_frame(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
-    """Split rows by frame number: ``{frame: (k, 10) rows}``."""
+    """Split rows by frame number: ``{frame: (k, 10) rows}``.
+
+    Raises
+    ------
+    TypeError
+        If `rows` is not an array (None, a number, text, a list of rows).
+    ValueError
+        If it holds rows but is not 2-D (was: an IndexError of NumPy's for a 3-D array).
+    """
+    if not isinstance(rows, np.ndarray):
+        if isinstance(rows, (list, tuple)) and not rows:
+            return {}  # no rows, as before
+        raise TypeError(f"group_by_frame: rows must be an (M, 10) array, got {shown(rows)}")
     if len(rows) == 0:
         return {}
+    if rows.ndim != 2 or rows.shape[1] <= FRAME:
+        raise ValueError(f"group_by_frame: rows has shape {rows.shape}, expected (M, 10)")
     order = np.argsort(rows[:, FRAME], kind="stable")
     r = rows[order]
     frames, starts = np.unique(r[:, FRAME].astype(np.int64), return_index=True)

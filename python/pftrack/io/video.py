@@ -42,7 +42,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import Any, BinaryIO, Literal
 
 import cv2
 import numpy as np
@@ -1006,8 +1006,9 @@ def _frame_list(indexes: list[int]) -> str:
     return f"frame{'s' * (len(indexes) > 1)} {text}"
 
 
-def video_files(folder: Path) -> list[Path]:
+def video_files(folder: PathLike) -> list[Path]:
     """The video files (:data:`VIDEO_SUFFIXES`) directly in `folder`, in natural order."""
+    folder = Path(path_arg(folder, "video_files: folder"))  # was: an AttributeError for a str
     return sorted(
         (p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in VIDEO_SUFFIXES),
         key=lambda p: natural_key(p.name),
@@ -1403,20 +1404,30 @@ _JPEG_SOF = frozenset(range(0xC0, 0xD0)) - {0xC4, 0xC8, 0xCC}
 
 
 def _header_size(path: Path) -> tuple[int, int] | None:
-    """(width, height) of a PNG or JPEG file from its header, as stored; None if not told.
+    """(width, height) of an image file from its header, as stored; None if not told.
 
+    PNG, JPEG, BMP, TIFF or WebP.
     A few bytes a file: PNG's IHDR (bytes 16-24), JPEG's start-of-frame segment, walked to
     marker by marker from the start, each segment skipped by its length (EXIF's thumbnail
-    unread). Not told: another format, a file too short or damaged there (read as a frame, it
-    is refused or stood in for then, as before). As stored: OpenCV turns a JPEG by its EXIF
-    orientation as it reads it, so a size that is the other's turned is not told apart here.
+    unread); BMP's info header (:func:`_bmp_size`), TIFF's first directory (:func:`_tiff_size`),
+    WebP's first chunk (:func:`_webp_size`). Not told: another format, a file too short or
+    damaged there (read as a frame, it is refused or stood in for then, as before). As stored:
+    OpenCV turns a JPEG by its EXIF orientation as it reads it, so a size that is the other's
+    turned is not told apart here.
     """
     try:
         with path.open("rb") as fh:
-            head = fh.read(24)
+            head = fh.read(30)
             if head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR":
-                w, h = int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
-                return (w, h) if w and h else None
+                return _positive(
+                    int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+                )
+            if head[:2] == b"BM":
+                return _bmp_size(head)
+            if head[:4] in (b"II*\x00", b"MM\x00*"):
+                return _tiff_size(fh, "little" if head[:2] == b"II" else "big")
+            if head[:4] == b"RIFF" and head[8:12] == b"WEBP":
+                return _webp_size(head)
             if head[:2] != b"\xff\xd8":
                 return None
             fh.seek(2)
@@ -1432,8 +1443,9 @@ def _header_size(path: Path) -> tuple[int, int] | None:
                     frame = fh.read(5)  # precision, height, width
                     if len(frame) < 5:
                         return None
-                    w, h = int.from_bytes(frame[3:5], "big"), int.from_bytes(frame[1:3], "big")
-                    return (w, h) if w and h else None
+                    return _positive(
+                        int.from_bytes(frame[3:5], "big"), int.from_bytes(frame[1:3], "big")
+                    )
                 if marker[1] in (0xD9, 0xDA) or length < 2:  # end or scan before a frame
                     return None
                 fh.seek(length - 2, os.SEEK_CUR)
@@ -1442,15 +1454,89 @@ def _header_size(path: Path) -> tuple[int, int] | None:
     return None
 
 
+def _positive(w: int, h: int) -> tuple[int, int] | None:
+    """``(w, h)`` if both are above 0 (a header's size), else None (not told)."""
+    return (w, h) if w > 0 and h > 0 else None
+
+
+def _bmp_size(head: bytes) -> tuple[int, int] | None:
+    """(width, height) from a BMP's first 30 bytes: its info header after the 14-byte file header.
+
+    BITMAPCOREHEADER (12 bytes): unsigned 16-bit width and height at 18 and 20; the longer
+    ones (BITMAPINFOHEADER, 40 bytes, and V4, V5): signed 32-bit at 18 and 22, little-endian, a
+    negative height a top-down image (its rows stored first to last), of that height.
+    """
+    if len(head) < 26:
+        return None
+    info = int.from_bytes(head[14:18], "little")
+    if info == 12:
+        return _positive(
+            int.from_bytes(head[18:20], "little"), int.from_bytes(head[20:22], "little")
+        )
+    if info < 40:
+        return None
+    w = int.from_bytes(head[18:22], "little", signed=True)
+    h = int.from_bytes(head[22:26], "little", signed=True)
+    return _positive(w, abs(h))
+
+
+def _tiff_size(fh: BinaryIO, order: Literal["little", "big"]) -> tuple[int, int] | None:
+    """(width, height) from a TIFF's first image directory, the page OpenCV reads.
+
+    Tags 256 and 257 (ImageWidth, ImageLength), each a SHORT (type 3) or LONG (type 4) held in
+    its entry, in the file's byte order (``II`` little, ``MM`` big).
+    """
+    fh.seek(4)
+    offset = int.from_bytes(fh.read(4), order)
+    fh.seek(offset)
+    count = fh.read(2)
+    if len(count) < 2:
+        return None
+    n = int.from_bytes(count, order)
+    entries = fh.read(12 * n)
+    size: dict[int, int] = {}
+    for k in range(0, len(entries) - 11, 12):
+        tag, kind = (
+            int.from_bytes(entries[k : k + 2], order),
+            int.from_bytes(entries[k + 2 : k + 4], order),
+        )
+        if tag in (256, 257) and kind in (3, 4):
+            value = entries[k + 8 : k + (10 if kind == 3 else 12)]
+            size[tag] = int.from_bytes(value, order)
+    return _positive(size.get(256, 0), size.get(257, 0))
+
+
+def _webp_size(head: bytes) -> tuple[int, int] | None:
+    """(width, height) from a WebP's first 30 bytes: its first chunk, at byte 12.
+
+    ``VP8 `` (lossy): the key frame's 14-bit width and height at 26 and 28, after its start
+    code ``9D 01 2A``; ``VP8L`` (lossless): after the signature byte ``2F``, 14 bits of width
+    - 1 and 14 of height - 1, little-endian; ``VP8X`` (extended): the canvas's 24-bit width - 1
+    and height - 1 at 24 and 27.
+    """
+    if len(head) < 30:
+        return None
+    chunk = head[12:16]
+    if chunk == b"VP8 " and head[23:26] == b"\x9d\x01\x2a":
+        w = int.from_bytes(head[26:28], "little") & 0x3FFF
+        return _positive(w, int.from_bytes(head[28:30], "little") & 0x3FFF)
+    if chunk == b"VP8L" and head[20] == 0x2F:
+        bits = int.from_bytes(head[21:25], "little")
+        return (bits & 0x3FFF) + 1, ((bits >> 14) & 0x3FFF) + 1
+    if chunk == b"VP8X":
+        return int.from_bytes(head[24:27], "little") + 1, int.from_bytes(head[27:30], "little") + 1
+    return None
+
+
 def _odd_size(
     images: Sequence[Path], first: int
 ) -> tuple[Path, tuple[int, int], tuple[int, int]] | None:
     """The first image of a folder whose header's size is another than image `first`'s.
 
-    :func:`_header_size` of each (PNG and JPEG; another format, or one not told, is checked
-    when read, :meth:`FrameSource._read_image`). A size that is the other turned (``480x640``
-    beside ``640x480``) is left to the read: an EXIF orientation may turn it back. Returns the
-    image, its size and image `first`'s, or None.
+    :func:`_header_size` of each (PNG, JPEG, BMP, TIFF and WebP; another format, or one not
+    told, is checked when read, :meth:`FrameSource._read_image`). A size that is the other
+    turned (``480x640`` beside ``640x480``) is left to the read: an EXIF orientation may turn it
+    back. Returns the image, its size and image `first`'s, or None.
     """
     size = _header_size(images[first])
     if size is None:
@@ -1522,13 +1608,14 @@ def _unreadable(path: Path, notes: Sequence[str]) -> _Unreadable:
     return _Unreadable(path, why)
 
 
-def image_files(folder: Path) -> list[Path]:
+def image_files(folder: PathLike) -> list[Path]:
     """The image files (:data:`IMAGE_SUFFIXES`) directly in `folder`, in no particular order.
 
     Hidden files (names starting with a point) are left out, as ``ls`` leaves them: macOS's
     ``._000001.jpg`` beside each image of a folder copied from its disks, a viewer's
     ``.thumb.jpg`` (were: frames, or an image that could not be read; a user trial).
     """
+    folder = Path(path_arg(folder, "image_files: folder"))  # was: an AttributeError for a str
     return [p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.name[0] != "."]
 
 
@@ -1782,12 +1869,11 @@ class FrameSource:
         If it is empty or a negative camera index; if it cannot be opened or decoded, or holds
         no frame (an image folder none of whose images can be read: the count and the first's
         reason); if two images of a folder have one number, or another size than the first
-        that can be read (a PNG or JPEG when the folder is opened, from its header,
-        :func:`_odd_size`; another when read), or are 16-bit where it is 8-bit (when read); or
-        if a MOTChallenge
-        sequence's image folder is named by number and one is missing (a hole in the
-        numbering, numbers that do not start at 1 or a count other than ``seqLength``); if
-        read (iterated, :meth:`frames_at`) after :meth:`stop`.
+        that can be read (a PNG, JPEG, BMP, TIFF or WebP when the folder is opened, from its
+        header, :func:`_odd_size`; another when read), or are 16-bit where it is 8-bit (when
+        read); or if a MOTChallenge sequence's image folder is named by number and one is
+        missing (a hole in the numbering, numbers that do not start at 1 or a count other than
+        ``seqLength``); if read (iterated, :meth:`frames_at`) after :meth:`stop`.
 
     Warns
     -----

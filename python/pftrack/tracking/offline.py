@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _check
-from pftrack._check import MAX_FRAME, brief, real_array
+from pftrack._check import MAX_FRAME, brief, real_array, shown
 from pftrack._progress import progress
 from pftrack._stats import median
 from pftrack._typing import F64, IntLike, RecoveryMethod
@@ -633,7 +633,11 @@ def smoothed_copies(rows: NDArray[np.float64]) -> NDArray[np.bool_]:
     exact=smoothed_copies(rows))`` writes the given values with all their digits, as
     ``pftrack smooth`` does.
     """
-    mask = np.zeros(np.shape(rows), dtype=bool)
+    if not isinstance(rows, np.ndarray):
+        raise TypeError(f"smoothed_copies: rows must be an (M, 10) array, got {shown(rows)}")
+    if rows.ndim != 2:  # was: NumPy's IndexError ("too many indices for array")
+        raise ValueError(f"smoothed_copies: rows has shape {rows.shape}, expected (M, 10)")
+    mask = np.zeros(rows.shape, dtype=bool)
     mask[:, 6:] = True
     return mask
 

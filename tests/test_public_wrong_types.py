@@ -1,0 +1,102 @@
+"""Public functions given the wrong type: a one-line TypeError or ValueError naming them.
+
+left63's probe (6 December) called each public function of pftrack and its subpackages with
+None, text, a float NaN, a 3-D array and an empty array for each argument. These failed with
+an AttributeError, an IndexError of NumPy's or a message of several lines (an array's repr);
+``pftrack.render`` is pipe63's and is left out here. pftrack.synthetic's warp_frame failed
+with OpenCV's assertion over several lines.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from pftrack import batch, synthetic
+from pftrack.detection import light
+from pftrack.io import group_by_frame
+from pftrack.io.video import image_files, video_files
+from pftrack.tracking.offline import smoothed_copies
+
+_BAD: dict[str, object] = {
+    "None": None,
+    "str": "x",
+    "nan": math.nan,
+    "3-D": np.zeros((2, 3, 4)),
+    "empty": np.zeros(0),
+}
+_FRAME = np.full((6, 8, 3), 50, np.uint8)
+_ROWS = np.zeros((0, 10))
+_AFFINE = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+
+#: name -> (function, the arguments it is called with, the index of the one replaced)
+CALLS: dict[str, tuple[Callable[..., Any], tuple[Any, ...], int]] = {
+    "group_by_frame": (group_by_frame, (_ROWS,), 0),
+    "smoothed_copies": (smoothed_copies, (_ROWS,), 0),
+    "is_dark": (light.is_dark, (_FRAME,), 0),
+    "is_blank": (light.is_blank, (_FRAME,), 0),
+    "channel_spread": (light.channel_spread, (_FRAME,), 0),
+    "frame_gain frame": (light.frame_gain, (_FRAME, _FRAME), 0),
+    "frame_gain reference": (light.frame_gain, (_FRAME, _FRAME), 1),
+    "sample_step": (light.sample_step, ((6, 8, 3),), 0),
+    "fingerprint": (batch.fingerprint, ([],), 0),
+    "warp_frame frame": (synthetic.warp_frame, (_FRAME, _AFFINE), 0),
+    "warp_frame affine": (synthetic.warp_frame, (_FRAME, _AFFINE), 1),
+    "warp_rows rows": (synthetic.warp_rows, (_ROWS, _AFFINE[None], (6, 8)), 0),
+    "warp_rows affines": (synthetic.warp_rows, (_ROWS, _AFFINE[None], (6, 8)), 1),
+    "warp_rows size": (synthetic.warp_rows, (_ROWS, _AFFINE[None], (6, 8)), 2),
+    "move_camera": (synthetic.move_camera, (None,), 0),
+    "track_sequence seq": (batch.track_sequence, (None, batch.TrackOptions()), 0),
+    "track_sequence options": (batch.track_sequence, (None, None), 1),
+    "recover_file options": (batch.recover_file, ("t.txt", None), 1),
+    "smooth_file options": (batch.smooth_file, ("t.txt", None), 1),
+}
+
+
+@pytest.mark.parametrize("bad", list(_BAD), ids=str)
+@pytest.mark.parametrize("name", list(CALLS), ids=str)
+def test_a_wrong_argument_is_one_line_naming_the_function(name: str, bad: str) -> None:
+    fn, args, k = CALLS[name]
+    given = list(args)
+    given[k] = _BAD[bad]
+    if name == "track_sequence options":  # the sequence checked first: a real one here
+        given[0] = batch.SequenceInput(name="s", frames="s/img1")
+    if bad == "empty" and name in ("group_by_frame", "fingerprint"):
+        assert not fn(*given)  # no rows, no paths: taken, as before
+        return
+    if bad == "3-D" and name == "warp_frame frame":
+        assert fn(*given).shape == (2, 3, 4)  # a 4-channel image: warped, as before
+        return
+    with pytest.raises((TypeError, ValueError)) as info:
+        fn(*given)
+    message = str(info.value)
+    assert "\n" not in message and message.startswith(name.split()[0]), message
+
+
+def test_the_checks_keep_what_worked(tmp_path: Path) -> None:
+    frame = _FRAME
+    assert group_by_frame(_ROWS) == {} and group_by_frame([]) == {}
+    rows = np.array([[2, 1, 0, 0, 5, 5, 1, -1, -1, -1], [1, 1, 0, 0, 5, 5, 1, -1, -1, -1.0]])
+    assert sorted(group_by_frame(rows)) == [1, 2]
+    assert smoothed_copies(rows)[:, 6:].all() and not smoothed_copies(rows)[:, :6].any()
+    assert light.is_dark(frame[:, :, ::-1]) is False  # a view of another stride, as before
+    assert light.frame_gain(frame, frame.astype(np.float32)) == 1.0  # a model's background
+    (tmp_path / "a.mp4").write_bytes(b"")
+    (tmp_path / "1.png").write_bytes(b"")
+    assert video_files(str(tmp_path)) == [tmp_path / "a.mp4"]  # a str: was an AttributeError
+    assert image_files(str(tmp_path)) == [tmp_path / "1.png"]
+    entry = batch.fingerprint([str(tmp_path / "a.mp4")])[0]
+    assert entry["path"] == str(tmp_path / "a.mp4") and entry["size"] == 0
+    with pytest.raises(TypeError, match="^fingerprint: paths must be a sequence of paths"):
+        batch.fingerprint(str(tmp_path))  # one path, not a list: was each letter's stat
+    moved = synthetic.warp_frame(frame, _AFFINE.tolist())  # a list of lists, as before
+    np.testing.assert_array_equal(moved, frame)
+    one = np.array([1, 1, 0, 0, 4, 4, 1, -1, -1, -1.0])  # one row, 1-D: taken as before
+    np.testing.assert_array_equal(synthetic.warp_rows(one, _AFFINE[None], (6, 8)), one[None])
+    with pytest.raises(TypeError, match="^inputs\\[0\\] must be a path .*got ndarray of shape"):
+        batch.track_many([np.zeros((2, 3))], out_dir=tmp_path / "o")  # was the array's repr
