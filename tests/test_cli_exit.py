@@ -18,6 +18,19 @@ def video(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return make_scene(n_frames=30, rng=0).write_video(tmp_path_factory.mktemp("v") / "s.avi")
 
 
+def _console_lines(argv: list[str]) -> list[str]:
+    """The lines `pftrack ARGV` prints, run as the console script runs it (``_console.main`` in
+    a process of its own), the last being whether objects were frozen at its exit."""
+    code = (
+        "import atexit, gc, sys; "
+        "atexit.register(lambda: print('frozen', gc.get_freeze_count() > 0)); "
+        f"sys.argv = ['pftrack', *{argv!r}]; "
+        "from pftrack._console import main; sys.exit(main())"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return run.stdout.splitlines()
+
+
 def test_the_console_process_freezes_its_objects_once_the_outputs_are_written(
     video: Path, tmp_path: Path
 ) -> None:
@@ -25,15 +38,8 @@ def test_the_console_process_freezes_its_objects_once_the_outputs_are_written(
     passes over every object (0.15-0.2 s of a PETS09 run at load; the same file, the same
     summary)."""
     out = tmp_path / "t.txt"
-    code = (
-        "import atexit, gc, sys; "
-        "atexit.register(lambda: print('frozen', gc.get_freeze_count() > 0)); "
-        f"sys.argv = ['pftrack', 'track', {str(video)!r}, '--out', {str(out)!r}]; "
-        "from pftrack._console import main; sys.exit(main())"
-    )
-    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    lines = run.stdout.splitlines()
-    assert lines[-1] == "frozen True", run.stdout
+    lines = _console_lines(["track", str(video), "--out", str(out)])
+    assert lines[-1] == "frozen True", lines
     assert "30 frames" in lines[-2] and out.stat().st_size > 0
 
 
@@ -54,12 +60,6 @@ def test_every_command_freezes_its_objects_in_the_console_process(
     over every object at their exit too."""
     tracks, out = tmp_path / "t.txt", tmp_path / "o.txt"
     assert main(["-q", "track", str(video), "--out", str(tracks)]) == 0
-    code = (
-        "import atexit, gc, sys; "
-        "atexit.register(lambda: print('frozen', gc.get_freeze_count() > 0)); "
-        f"sys.argv = ['pftrack', '-q', {command!r}, {str(tracks)!r}, '--out', {str(out)!r}]; "
-        "from pftrack._console import main; sys.exit(main())"
-    )
-    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert run.stdout.splitlines()[-1] == "frozen True", run.stdout
+    lines = _console_lines(["-q", command, str(tracks), "--out", str(out)])
+    assert lines[-1] == "frozen True", lines
     assert out.stat().st_size > 0

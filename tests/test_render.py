@@ -584,6 +584,31 @@ def test_a_long_title_is_wrapped_on_a_narrow_frame(tmp_path: Path) -> None:
     assert title_ink(640)[:, 0].max() <= 20  # one line where the frame is wide enough
 
 
+def _tags_drawn(monkeypatch: pytest.MonkeyPatch) -> list[tuple[int, int, int, int]]:
+    """The boxes of the id tags ``pftrack.render`` draws from now on, in order."""
+    import pftrack.render as render
+
+    boxes: list[tuple[int, int, int, int]] = []
+    tag = render._tag
+
+    def spy(*args: Any, **kwargs: Any) -> tuple[int, int, int, int]:
+        box = tag(*args, **kwargs)
+        boxes.append(box)
+        return box
+
+    monkeypatch.setattr(render, "_tag", spy)
+    return boxes
+
+
+def _assert_apart_inside(boxes: list[tuple[int, int, int, int]], width: int, height: int) -> None:
+    """Every tag whole inside a `width` x `height` picture, and none touching another."""
+    for i, a in enumerate(boxes):
+        assert 0 <= a[0] <= a[2] < width and 0 <= a[1] <= a[3] < height, a
+        for b in boxes[:i]:
+            apart = a[2] < b[0] or b[2] < a[0] or a[3] < b[1] or b[3] < a[1]
+            assert apart, (a, b)
+
+
 @pytest.mark.parametrize("background", [False, True])
 def test_plot_ids_of_paths_that_begin_or_end_together_do_not_overlap(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, background: bool
@@ -591,17 +616,8 @@ def test_plot_ids_of_paths_that_begin_or_end_together_do_not_overlap(
     """Was (trial61): ids drawn on top of one another at the plot's right edge, where people
     walk in together. Three tracks from one spot past the right edge to one spot in the middle:
     their id tags (and those of three more from one spot mid-plot) are moved apart, inside it."""
-    import pftrack.render as render
 
-    boxes: list[tuple[int, int, int, int]] = []
-
-    def spy(*args: Any, **kwargs: Any) -> tuple[int, int, int, int]:
-        box = tag(*args, **kwargs)
-        boxes.append(box)
-        return box
-
-    tag = render._tag
-    monkeypatch.setattr(render, "_tag", spy)
+    boxes = _tags_drawn(monkeypatch)
     rows = np.array(
         [[f, tid, left, 40.0 + 2 * f, 20.0, 40.0] for tid in (1, 2, 3, 104, 105, 106)
          for f, left in ((1, 195.0 if tid < 100 else 80.0), (2, 90.0))],
@@ -611,11 +627,7 @@ def test_plot_ids_of_paths_that_begin_or_end_together_do_not_overlap(
     else:
         plot_trajectories(tmp_path / "p.png", rows, size=(200, 150))
     assert len(boxes) == 6
-    for i, a in enumerate(boxes):
-        assert 0 <= a[0] <= a[2] < 200 and 0 <= a[1] <= a[3] < 150, a  # whole inside
-        for b in boxes[:i]:
-            apart = a[2] < b[0] or b[2] < a[0] or a[3] < b[1] or b[3] < a[1]
-            assert apart, (a, b)
+    _assert_apart_inside(boxes, 200, 150)
 
 
 def test_video_ids_of_people_side_by_side_do_not_overlap(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -625,15 +637,7 @@ def test_video_ids_of_people_side_by_side_do_not_overlap(monkeypatch: pytest.Mon
     the frame number stays in its corner."""
     import pftrack.render as render
 
-    boxes: list[tuple[int, int, int, int]] = []
-
-    def spy(*args: Any, **kwargs: Any) -> tuple[int, int, int, int]:
-        box = tag(*args, **kwargs)
-        boxes.append(box)
-        return box
-
-    tag = render._tag
-    monkeypatch.setattr(render, "_tag", spy)
+    boxes = _tags_drawn(monkeypatch)
     rows = np.array(
         [[1, tid, left, 60.0 if tid < 15 else 24.0, 30.0, 60.0, 1, -1, -1, -1]
          for tid, left in ((11, 100.0), (12, 104.0), (13, 96.0), (14, 102.0), (15, 8.0))]
@@ -643,11 +647,7 @@ def test_video_ids_of_people_side_by_side_do_not_overlap(monkeypatch: pytest.Mon
     boxes.clear()
     out = render.draw_tracks(np.zeros((160, 240, 3), np.uint8), rows, "frame 1")
     assert len(boxes) == 6 and boxes[0] == first[0] and boxes[-1] == first[-1]
-    for i, a in enumerate(boxes):
-        assert 0 <= a[0] <= a[2] < 240 and 0 <= a[1] <= a[3] < 160, a  # whole inside
-        for b in boxes[:i]:
-            apart = a[2] < b[0] or b[2] < a[0] or a[3] < b[1] or b[3] < a[1]
-            assert apart, (a, b)
+    _assert_apart_inside(boxes, 240, 160)
     # the frame number where it was, over the boxes; the first id too, the others each within
     # a few tags' heights of where it was asked
     np.testing.assert_array_equal(out[: first[-1][3] + 1, :60], alone[: first[-1][3] + 1, :60])
