@@ -202,22 +202,7 @@ public:
         const double norm = std::sqrt(static_cast<double>(total));
         const double* tab = sqrt_table(static_cast<size_t>(total));
         const auto term = [&](int k) { return tab[c[k]] * sqrt_ref[k]; };
-        const std::int16_t *b0 = present.bins[0], *b1 = present.bins[1], *b2 = present.bins[2],
-                           *b3 = present.bins[3];
-        const int n0 = present.n[0], n1 = present.n[1], n2 = present.n[2], n3 = present.n[3];
-        const int m = std::min(std::min(n0, n1), std::min(n2, n3));
-        double r0 = 0.0, r1 = 0.0, r2 = 0.0, r3 = 0.0;
-        for (int j = 0; j < m; ++j) {
-            r0 += term(b0[j]);
-            r1 += term(b1[j]);
-            r2 += term(b2[j]);
-            r3 += term(b3[j]);
-        }
-        for (int j = m; j < n0; ++j) r0 += term(b0[j]);
-        for (int j = m; j < n1; ++j) r1 += term(b1[j]);
-        for (int j = m; j < n2; ++j) r2 += term(b2[j]);
-        for (int j = m; j < n3; ++j) r3 += term(b3[j]);
-        return ((r0 + r1) + (r2 + r3)) / norm;
+        return lane_sums(present.bins, present.n, term) / norm;
     }
 
     /// Takes the reference's square roots of the bins of `present` (an integral histogram's
@@ -242,22 +227,7 @@ public:
         const std::uint16_t* cnt = present.counts;
         const double* sref = sref_local_.data();
         const auto term = [&](int l) { return tab[cnt[l]] * sref[l]; };
-        const std::int16_t *l0 = present.local[0], *l1 = present.local[1], *l2 = present.local[2],
-                           *l3 = present.local[3];
-        const int n0 = present.n[0], n1 = present.n[1], n2 = present.n[2], n3 = present.n[3];
-        const int m = std::min(std::min(n0, n1), std::min(n2, n3));
-        double r0 = 0.0, r1 = 0.0, r2 = 0.0, r3 = 0.0;
-        for (int j = 0; j < m; ++j) {
-            r0 += term(l0[j]);
-            r1 += term(l1[j]);
-            r2 += term(l2[j]);
-            r3 += term(l3[j]);
-        }
-        for (int j = m; j < n0; ++j) r0 += term(l0[j]);
-        for (int j = m; j < n1; ++j) r1 += term(l1[j]);
-        for (int j = m; j < n2; ++j) r2 += term(l2[j]);
-        for (int j = m; j < n3; ++j) r3 += term(l3[j]);
-        return ((r0 + r1) + (r2 + r3)) / norm;
+        return lane_sums(present.local, present.n, term) / norm;
     }
 
     // Boxes of fewer pixels look sqrt(count) up in a table (110 square roots per box cost as
@@ -265,6 +235,28 @@ public:
     static constexpr std::int64_t kSqrtTableMax = std::int64_t(1) << 16;
 
 private:
+    /// ((r0 + r1) + (r2 + r3)) where r_q adds term(index[q][j]) for j = 0 .. n[q] in order,
+    /// the four sums advancing together, in registers (coefficient_of_counts of `present`'s
+    /// bins, coefficient_of_compact of their compact indices: one order, so bit for bit the
+    /// same sums).
+    template <class Term>
+    static double lane_sums(const std::int16_t* const (&index)[4], const int (&n)[4], Term term) {
+        const std::int16_t *i0 = index[0], *i1 = index[1], *i2 = index[2], *i3 = index[3];
+        const int n0 = n[0], n1 = n[1], n2 = n[2], n3 = n[3];
+        const int m = std::min(std::min(n0, n1), std::min(n2, n3));
+        double r0 = 0.0, r1 = 0.0, r2 = 0.0, r3 = 0.0;
+        for (int j = 0; j < m; ++j) {
+            r0 += term(i0[j]);
+            r1 += term(i1[j]);
+            r2 += term(i2[j]);
+            r3 += term(i3[j]);
+        }
+        for (int j = m; j < n0; ++j) r0 += term(i0[j]);
+        for (int j = m; j < n1; ++j) r1 += term(i1[j]);
+        for (int j = m; j < n2; ++j) r2 += term(i2[j]);
+        for (int j = m; j < n3; ++j) r3 += term(i3[j]);
+        return (r0 + r1) + (r2 + r3);
+    }
 
     /// sqrt(0 .. at_least), grown on demand (each entry exactly std::sqrt of its index). One
     /// table per thread, kept from call to call: a scratch made per object and frame filled
