@@ -161,9 +161,9 @@ def _tag(
     size = _text_size(text, scale, k) if size is None else size
     (x, y), box = _tag_place(image.shape, org, k, size)
     if taken:
-        (tw, th), base = size
-        y = _free_y(taken, x - k, x + tw + k - 1, y, th + k, base, image.shape[0])
-        box = (x - k, y - th - k, x + tw + k - 1, y + base)
+        (_, th), base = size
+        moved = _free_y(taken, box[0], box[2], y, th + k, base, image.shape[0]) - y
+        y, box = y + moved, (box[0], box[1] + moved, box[2], box[3] + moved)
     if taken is not None:
         taken.append(box)
     cv2.rectangle(image, box[:2], box[2:], colour, -1)
@@ -505,9 +505,8 @@ class TrackRenderer:
         for tid in set(self._trails) - seen:
             del self._trails[tid]
         trails = {tid: list(pts) for tid, pts in self._trails.items()}
-        table = np.asarray(rows, dtype=np.float64).reshape(-1, 10)
-        if not np.isfinite(table[:, :6]).all():  # named here, in the caller's thread (was: by
-            _track_rows(table, "TrackRenderer.add", "tracks")  # the worker, at a later call)
+        # checked here, in the caller's thread (was: a NaN box named by the worker, later)
+        table = _track_rows(np.reshape(rows, (-1, 10)), "TrackRenderer.add", "tracks")
         job = (self._n, frame, table, trails)
         if self._queue is None:
             self._draw(job)

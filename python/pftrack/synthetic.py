@@ -20,7 +20,17 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import brief, flag, generator, instance, number, option, real, shown
+from pftrack._check import (
+    brief,
+    flag,
+    generator,
+    instance,
+    number,
+    option,
+    real,
+    real_array,
+    shown,
+)
 from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
@@ -526,10 +536,7 @@ def camera_path(
 
 def _affines(value: object, what: str, shape: tuple[int, ...]) -> NDArray[np.float64]:
     """`value` as a finite float64 array of `shape` (-1: any length), or TypeError/ValueError."""
-    try:
-        a = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TypeError(f"{what} must be an array of numbers, got {shown(value)}") from None
+    a = real_array(value, what, booleans=False)  # TypeError: not numbers; ValueError: ragged
     if a.ndim != len(shape) or any(n not in (-1, m) for n, m in zip(shape, a.shape, strict=True)):
         expected = ", ".join("T" if n == -1 else str(n) for n in shape)
         raise ValueError(f"{what} has shape {a.shape}, expected ({expected})")

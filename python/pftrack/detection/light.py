@@ -208,10 +208,12 @@ def frame_gain(
     float
     """
     frame = check_frame(frame, "frame_gain")
-    if not isinstance(reference, np.ndarray) or reference.shape != frame.shape:
-        raise (ValueError if isinstance(reference, np.ndarray) else TypeError)(
+    if not isinstance(reference, np.ndarray):
+        raise TypeError(f"frame_gain: reference must be an array, got {shown(reference)}")
+    if reference.shape != frame.shape:
+        raise ValueError(
             f"frame_gain: reference must be an array of the frame's shape {frame.shape}, got "
-            f"{shown(reference) if not isinstance(reference, np.ndarray) else reference.shape}"
+            f"{reference.shape}"
         )
     step = sample_step(frame.shape) if step is None else step
     sr = _pixel_sums(reference[::step, ::step])
