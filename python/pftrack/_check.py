@@ -200,7 +200,12 @@ def refuse_masked(
     # MaskedArray made by a caller can exist then): was an AttributeError on `track
     # --render`'s drawing thread after a Ctrl-C, once runs stopped importing numpy.ma early
     masked_array = getattr(ma, "MaskedArray", None)
-    if masked_array is not None and isinstance(values, masked_array) and ma.is_masked(values):
+    if (
+        ma is not None
+        and masked_array is not None
+        and isinstance(values, masked_array)
+        and ma.is_masked(values)
+    ):
         n = int(np.count_nonzero(ma.getmaskarray(values)))
         raise TypeError(
             f"{what} is a numpy.ma.MaskedArray with {counted(n, 'masked value')}, whose mask "

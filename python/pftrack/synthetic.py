@@ -18,7 +18,7 @@ from typing import Any
 
 import cv2
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import (
     brief,
@@ -534,7 +534,7 @@ def camera_path(
     return out
 
 
-def _affines(value: object, what: str, shape: tuple[int, ...]) -> NDArray[np.float64]:
+def _affines(value: ArrayLike, what: str, shape: tuple[int, ...]) -> NDArray[np.float64]:
     """`value` as a finite float64 array of `shape` (-1: any length), or TypeError/ValueError."""
     a = real_array(value, what, booleans=False)  # TypeError: not numbers; ValueError: ragged
     if a.ndim != len(shape) or any(n not in (-1, m) for n, m in zip(shape, a.shape, strict=True)):
