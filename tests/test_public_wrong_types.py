@@ -3,8 +3,9 @@
 left63's probe (6 December) called each public function of pftrack and its subpackages with
 None, text, a float NaN, a 3-D array and an empty array for each argument. These failed with
 an AttributeError, an IndexError of NumPy's or a message of several lines (an array's repr);
-``pftrack.render`` is pipe63's and is left out here. pftrack.synthetic's warp_frame failed
-with OpenCV's assertion over several lines.
+pftrack.synthetic's warp_frame failed with OpenCV's assertion over several lines. left64
+(6 December) added ``pftrack.render``'s ``ink_scale`` and ``draw_trails``: AttributeError,
+IndexError, NumPy's "cannot reshape" and "truth value ... ambiguous", OpenCV's assertion.
 """
 
 from __future__ import annotations
@@ -14,10 +15,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 import pytest
 
-from pftrack import batch, synthetic
+from pftrack import batch, render, synthetic
 from pftrack.detection import light
 from pftrack.io import group_by_frame
 from pftrack.io.video import image_files, video_files
@@ -33,6 +35,8 @@ _BAD: dict[str, object] = {
 _FRAME = np.full((6, 8, 3), 50, np.uint8)
 _ROWS = np.zeros((0, 10))
 _AFFINE = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+_CANVAS = np.full((6, 8, 3), 50, np.uint8)  # draw_trails draws in place: not _FRAME
+_TRAILS = {1: [(0.0, 0.0), (5.0, 4.0)]}
 
 #: name -> (function, the arguments it is called with, the index of the one replaced)
 CALLS: dict[str, tuple[Callable[..., Any], tuple[Any, ...], int]] = {
@@ -55,6 +59,9 @@ CALLS: dict[str, tuple[Callable[..., Any], tuple[Any, ...], int]] = {
     "track_sequence options": (batch.track_sequence, (None, None), 1),
     "recover_file options": (batch.recover_file, ("t.txt", None), 1),
     "smooth_file options": (batch.smooth_file, ("t.txt", None), 1),
+    "ink_scale": (render.ink_scale, ((6, 8, 3),), 0),
+    "draw_trails frame": (render.draw_trails, (_CANVAS, _TRAILS), 0),
+    "draw_trails trails": (render.draw_trails, (_CANVAS, _TRAILS), 1),
 }
 
 
@@ -100,3 +107,48 @@ def test_the_checks_keep_what_worked(tmp_path: Path) -> None:
     np.testing.assert_array_equal(synthetic.warp_rows(one, _AFFINE[None], (6, 8)), one[None])
     with pytest.raises(TypeError, match="^inputs\\[0\\] must be a path .*got ndarray of shape"):
         batch.track_many([np.zeros((2, 3))], out_dir=tmp_path / "o")  # was the array's repr
+
+
+def _trail_reference(frame: np.ndarray, trails: dict[int, Any]) -> np.ndarray:
+    """What draw_trails draws: each id's points rounded, one anti-aliased polyline (OpenCV)."""
+    out = frame.copy()
+    for tid, pts in trails.items():
+        line = np.round(np.asarray(pts, dtype=np.float64)).astype(np.int32).reshape(-1, 1, 2)
+        if len(line) > 1:
+            cv2.polylines(out, [line], False, render.colour_of(tid), 1, cv2.LINE_AA)
+    return out
+
+
+def test_draw_trails_and_ink_scale_refuse_in_one_line_and_draw_as_before() -> None:
+    frame = np.zeros((40, 50, 3), np.uint8)
+    trails = {3: [(1, 2), (30.4, 20.6), (45, 38)], np.int64(7): np.array([[0, 39], [49, 0.0]])}
+    expected = _trail_reference(frame, trails)
+    render.draw_trails(frame, trails)
+    np.testing.assert_array_equal(frame, expected)  # drawn in place, as before
+    crop = np.zeros((40, 50, 3), np.uint8)
+    render.draw_trails(crop[5:30, 5:40], trails)  # a crop's rows: drawn into, as before
+    assert crop[5:30, 5:40].any() and not crop[:5].any()
+    assert [render.ink_scale(s) for s in ([1080, 1920], np.array([2160, 3840, 3]))] == [2, 4]
+    refused = {
+        "read-only": (np.zeros((4, 5, 3), np.uint8), trails),
+        "flipped": (np.zeros((4, 5, 3), np.uint8)[:, ::-1], trails),
+        "Fortran": (np.asfortranarray(np.zeros((4, 5, 3), np.uint8)), trails),
+        "no pixels": (np.zeros((0, 5, 3), np.uint8), trails),
+        "NaN": (frame, {1: [(0, 0), (math.nan, 3)]}),
+        "far": (frame, {1: [(0, 0), (1e12, 3)]}),
+        "odd": (frame, {1: [1, 2, 3]}),
+        "3 columns": (frame, {1: np.zeros((3, 3))}),
+        "text": (frame, {1: "ab"}),
+        "text id": (frame, {"a": [(0, 0), (3, 3)]}),
+    }
+    refused["read-only"][0].flags.writeable = False
+    for case, (f, t) in refused.items():
+        before = frame.copy()
+        with pytest.raises((TypeError, ValueError)) as info:
+            render.draw_trails(f, t)
+        message = str(info.value)
+        assert message.startswith("draw_trails: ") and "\n" not in message, (case, message)
+        np.testing.assert_array_equal(frame, before)  # nothing drawn before the refusal
+    for shape, kind in (((-1, 5), ValueError), ((2.0, 5), TypeError), (frame, TypeError)):
+        with pytest.raises(kind, match="^ink_scale: shape "):
+            render.ink_scale(shape)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 import itertools
+import operator
 import queue
 import threading
 import time
@@ -16,7 +17,17 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pftrack._check import bgr_frame, brief, flag, integer, path_arg, real_array, text
+from pftrack._check import (
+    bgr_array,
+    bgr_frame,
+    brief,
+    flag,
+    integer,
+    number,
+    path_arg,
+    real_array,
+    text,
+)
 from pftrack._threads import join_through_interrupts
 from pftrack._typing import F64, PathLike, RealLike
 from pftrack.io.mot import group_by_frame
@@ -56,8 +67,26 @@ def ink_scale(shape: tuple[int, ...]) -> int:
     One step per 540 pixels of the shorter side, at least 1: 1 up to 1280x720 (as they always
     looked), 2 at 1920x1080, 4 at 3840x2160, so that labels stay readable when a large video
     is shown scaled down.
+
+    Raises
+    ------
+    TypeError
+        `shape` is not a sequence of at least two integers (a frame given for its shape:
+        ``ink_scale(frame.shape)``).
+    ValueError
+        Its height or width is negative.
     """
-    return max(1, min(shape[0], shape[1]) // 540)
+    try:  # was: an IndexError of a str or an empty array, NumPy's "truth value" of a frame
+        h, w = (operator.index(v) for v in shape[:2])
+    except (TypeError, ValueError, IndexError):
+        got = f"a {shape.shape} array" if isinstance(shape, np.ndarray) else brief(shape)
+        raise TypeError(
+            f"ink_scale: shape must be a frame's shape (H, W, ...) of integers, got {got}"
+            + ("; give frame.shape" if isinstance(shape, np.ndarray) and shape.ndim > 1 else "")
+        ) from None
+    if h < 0 or w < 0:
+        raise ValueError(f"ink_scale: shape is {tuple(shape)}, expected H, W >= 0")
+    return max(1, min(h, w) // 540)
 
 
 def draw_tracks(
@@ -229,9 +258,47 @@ def _dashed_rectangle(
 def draw_trails(
     frame: NDArray[np.uint8], trails: Mapping[int, Sequence[tuple[float, float]]]
 ) -> None:
-    """Draw each id's recent foot points on `frame` in place, as a line in the id's colour."""
+    """Draw each id's recent foot points on `frame` in place, as a line in the id's colour.
+
+    Raises
+    ------
+    TypeError
+        `frame` is not a uint8 array; `trails` is not a mapping of ids (numbers) to points;
+        an id's points are not real numbers.
+    ValueError
+        `frame` is not (H, W, 3) with pixels, is read-only, or is a view OpenCV cannot draw
+        into in place (a flipped or Fortran-ordered one); an id's points are not (n, 2), or
+        not finite within ±1e9.
+    """
+    # each was an AttributeError, an IndexError, NumPy's "cannot reshape" or OpenCV's
+    # assertion over several lines; NaN points were drawn at -2**31 with a RuntimeWarning
+    frame = bgr_array(frame, "draw_trails: frame")  # the same array: drawn in place
+    if frame.shape[0] == 0 or frame.shape[1] == 0:
+        raise ValueError(f"draw_trails: frame shape is {frame.shape}, expected H, W > 0")
+    if not frame.flags.writeable:
+        raise ValueError("draw_trails: frame is read-only; it is drawn in place (frame.copy())")
+    if frame.strides[0] < 0 or frame.strides[1:] != (3, 1):
+        raise ValueError(
+            f"draw_trails: frame has strides {frame.strides}, a view OpenCV cannot draw into "
+            "in place (flipped or Fortran-ordered): draw on np.ascontiguousarray(frame)"
+        )
+    if not isinstance(trails, Mapping):
+        raise TypeError(
+            f"draw_trails: trails must be a mapping of ids to foot points {{id: [(x, y), ...]}}, "
+            f"got {type(trails).__name__}"
+        )
+    lines = []
     for tid, pts in trails.items():
-        _trail_line(frame, pts, colour_of(tid))
+        number(tid, "draw_trails: trails' id")
+        what = f"draw_trails: trails[{tid!r}]"
+        a = real_array(pts, what, booleans=False)
+        if a.size and (a.ndim != 2 or a.shape[1] != 2):
+            raise ValueError(f"{what} has shape {a.shape}, expected (n, 2) points x, y")
+        if not np.all(np.abs(a) <= 1e9):
+            raise ValueError(f"{what} has NaN, inf or a value beyond ±1e9")
+        lines.append((a, colour_of(tid)))
+    for a, colour in lines:
+        _trail_line(frame, a, colour)
 
 
 def _foot(box: NDArray[np.float64]) -> tuple[float, float]:
