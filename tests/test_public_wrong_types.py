@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from pftrack import batch, render, synthetic
-from pftrack.detection import light
+from pftrack.detection import check_frame, light
 from pftrack.io import group_by_frame
 from pftrack.io.video import image_files, video_files
 from pftrack.tracking.offline import smoothed_copies
@@ -152,3 +152,16 @@ def test_draw_trails_and_ink_scale_refuse_in_one_line_and_draw_as_before() -> No
     for shape, kind in (((-1, 5), ValueError), ((2.0, 5), TypeError), (frame, TypeError)):
         with pytest.raises(kind, match="^ink_scale: shape "):
             render.ink_scale(shape)
+
+
+@pytest.mark.parametrize("fn", [np.zeros((3, 4)), None, 5, b"detect"], ids=str)
+@pytest.mark.parametrize("frame", [_FRAME, None, np.zeros((6, 8, 3))], ids=["good", "None", "f8"])
+def test_check_frame_names_its_own_fn_in_one_line(fn: object, frame: object) -> None:
+    """``check_frame(frame, fn=array)``: the array's repr began the message, over several lines
+    (a good frame passed, so a wrong `fn` showed only at a bad frame)."""
+    with pytest.raises(TypeError) as info:
+        check_frame(frame, fn)  # type: ignore[arg-type]
+    assert str(info.value).startswith("check_frame: fn must be a str") and "\n" not in str(
+        info.value
+    )
+    assert check_frame(_FRAME, "PaperDetector.detect") is _FRAME  # the same array, as before

@@ -193,8 +193,11 @@ class BlobConfig:
 def check_frame(frame: object, fn: str) -> NDArray[np.uint8]:
     """Return `frame` as a (H, W, 3) uint8 array, or raise naming the argument.
 
-    TypeError for what is not a uint8 array, ValueError for a wrong shape (:func:`bgr_array`).
+    TypeError for what is not a uint8 array, ValueError for a wrong shape (:func:`bgr_array`);
+    TypeError when `fn`, the caller's name its messages begin with, is not a str.
     """
+    if not isinstance(fn, str):  # was: an array's repr over several lines, at a bad frame only
+        raise TypeError(f"check_frame: fn must be a str (the caller's name), got {brief(fn)}")
     if not isinstance(frame, np.ndarray):
         raise TypeError(f"{fn}: frame is {type(frame).__name__}, expected a numpy.ndarray")
     f = bgr_array(frame, f"{fn}: frame")  # the same array
