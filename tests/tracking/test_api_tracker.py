@@ -1007,6 +1007,32 @@ def test_no_track_warning_names_min_hits_when_tracks_started():
     ]
 
 
+def test_no_track_warning_is_given_once_for_a_runs_frames():
+    """``finalize()`` called twice on the same frames gave the same warning twice (trial63);
+    it returns the same rows again without a word, and warns anew after more frames or a reset."""
+    frame = np.full((60, 80, 3), 100, np.uint8)
+    tracker = pftrack.Tracker()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for _ in range(3):
+            tracker.update(np.zeros((0, 5)), frame)
+        first, second = tracker.finalize(), tracker.finalize()
+        said = [str(c.message) for c in caught if "no track" in str(c.message)]
+        assert said == ["no track over 3 frames: the detections given held no box"]
+        assert first.shape == second.shape == (0, 10)
+        tracker.update(np.zeros((0, 5)), frame)  # one more frame: a new finding, said
+        tracker.finalize()
+        tracker.reset()
+        tracker.update(np.zeros((0, 5)), frame)
+        tracker.finalize()
+        tracker.finalize()
+    said = [str(c.message) for c in caught if "no track" in str(c.message)]
+    assert said[1:] == [
+        "no track over 4 frames: the detections given held no box",
+        "no track over 1 frame: the detections given held no box",
+    ]
+
+
 def _no_track_said(tracker, frames, dets=None) -> list[str]:
     """Track `frames` (each with `dets`, None: the built-in detector) to an empty finalize();
     the "no track" warnings it gave."""

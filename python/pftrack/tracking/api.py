@@ -1645,7 +1645,8 @@ class Tracker:
             when there is no row at all, naming the first cause that holds: tracks started
             but none reached ``min_hits`` matches, the built-in detector found nothing, the
             detections' confidences were below the birth threshold, or lay outside the frame,
-            or there were none. With the
+            or there were none (once: a second call, with no ``update`` between, returns
+            the same rows without warning again). With the
             built-in detector (no ``update`` of the run had detections) and the smoother on,
             boxes mostly inside a larger box of the same frame are left out
             (``LifecycleConfig.nested_inside``), and the boxes of partly seen people completed
@@ -1737,7 +1738,11 @@ class Tracker:
                 rows = rows[inside]
             kept = set(rows[:, 1].astype(int).tolist())
             self.classes = {i: c for i, c in self._writer.classes.items() if i in kept}
-            if len(rows) == 0 and self.frame_count:
+            # once for the run's frames: a second finalize() of them returns the same rows
+            # without a word (was: the same warning again); after more updates it is a new one
+            said = f"no track at {self.frame_count}"
+            if len(rows) == 0 and self.frame_count and said not in self._warned:
+                self._warned.add(said)
                 n = self.frame_count
                 warn(
                     f"no track over {n} frame{'s' * (n != 1)}: {self._no_track_cause(n_tracked)}",
