@@ -297,7 +297,7 @@ def run(args: argparse.Namespace) -> int:
         scores_json,
     )
     from pftrack.io.atomic import check_output, staged_outputs
-    from pftrack.io.mot import read_mot
+    from pftrack.io.mot import no_rows, read_mot
     from pftrack.recovery.linking import check_scored_ids
 
     _check_scales(args.scale or [])
@@ -319,6 +319,11 @@ def run(args: argparse.Namespace) -> int:
     with Bar(2 * len(jobs), desc="eval reading", enable=shown, unit="file") as reading:
         for name, seq, path in jobs:  # read and check everything before scoring anything
             gt = read_mot(seq.gt_path, what="ground truth")
+            if not len(gt):  # was: scored, every result box a false positive, exit 0
+                raise ValueError(
+                    f"ground truth {seq.gt_path} {no_rows(seq.gt_path)}: nothing to score "
+                    "against (a cut download or copy?)"
+                )
             if shown:  # off a terminal nothing is counted, as the scorers report nothing
                 reading.set(2 * len(loaded) + 1)
             res = read_mot(path, what="result file")
@@ -364,6 +369,11 @@ def run(args: argparse.Namespace) -> int:
                     message += f" (--benchmark auto took {folder[0]} from its folder {folder[1]})"
                 raise ValueError(message) from None
             bar.describe(_bar_label(k + 1, len(loaded)))
+            if not len(res):  # a tracker that found nothing: scored, and said
+                notes.append(
+                    f"{path} {no_rows(path)}: scored as tracks of nothing, every ground-truth "
+                    "box missed"
+                )
             note = result_class_note(res, scores[name].benchmark)
             if note:
                 notes.append(f"{path}: {note}")

@@ -250,6 +250,18 @@ def read_mot(
     return a
 
 
+def no_rows(path: PathLike) -> str:
+    """How a MOT file that :func:`read_mot` read as no row is described: a message's end.
+
+    ``is empty (0 bytes)`` or ``holds no row (only blank or comment lines)``. A tracks file
+    of no row is a tracker's finding (nothing tracked: ``pftrack track`` writes one, with a
+    warning); a ground truth of no row has nothing to score against (docs/io.md).
+    """
+    p = Path(path)
+    empty = p.is_file() and p.stat().st_size == 0
+    return "is empty (0 bytes)" if empty else "holds no row (only blank or comment lines)"
+
+
 #: What a refused first row with a word in it (``frame,id,bb_left,...``) is told.
 HEADER_HINT = " (a header line? delete it, or start it with # to keep it as a comment)"
 #: What a refused first row with a word and an empty first field is told: the header of
