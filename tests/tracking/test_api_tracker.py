@@ -58,6 +58,28 @@ SEQUENCES = {
     "pets09-s2l1": ("video.avi", 0.625),
     "tud-campus": ("video.mp4", 1.0),
 }
+#: Frames of a sequence the loop is compared on, where not all: PETS09's 795 frames took
+#: 147 s of CI's 2 busy cores (the CLI and the loop each track the whole video); its first
+#: 200 give 9 tracks, 1116 rows, 54 of them filled by the offline pass, at det.txt's 0.625.
+CLIP = {"pets09-s2l1": 200}
+
+
+def _clip(folder: Path, video: str, n: int, into: Path) -> tuple[Path, Path]:
+    """The first `n` frames of `folder`'s `video` (an MJPG AVI) and its det.txt's rows of them.
+
+    Both the command and the loop read the clip: what they must agree on is its frames, not
+    the original's pixels.
+    """
+    clip, det = into / "clip.avi", into / "det.txt"
+    source = FrameSource(folder / video)
+    first = next(iter(source))
+    writer = cv2.VideoWriter(str(clip), cv2.VideoWriter_fourcc(*"MJPG"), 7.0, first.shape[1::-1])
+    for frame in itertools.islice(FrameSource(folder / video), n):
+        writer.write(frame)
+    writer.release()
+    rows = read_mot(folder / "det.txt")
+    write_mot(det, rows[rows[:, 0] <= n], exact=True)
+    return clip, det
 
 
 @pytest.mark.dataset
@@ -69,16 +91,19 @@ def test_documented_loop_is_the_cli_byte_for_byte(name, dtype, tmp_path):
     """float32: a detector's usual dtype; its scores were written rounded to 2 decimals."""
     folder = dataset(name)
     video, scale = SEQUENCES[name]
+    source, det_path = folder / video, folder / "det.txt"
+    if name in CLIP:
+        source, det_path = _clip(folder, video, CLIP[name], tmp_path)
     cli_out = tmp_path / "cli.txt"
-    argv = ["track", str(folder / video), "--detections", str(folder / "det.txt")]
+    argv = ["track", str(source), "--detections", str(det_path)]
     assert main([*argv, "--det-scale", str(scale), "--out", str(cli_out)]) == 0
 
     # the README's loop: a detector's (N, 5) x1, y1, x2, y2, conf per frame
-    det = read_mot(folder / "det.txt")
+    det = read_mot(det_path)
     by_frame = group_by_frame(det)
     tracker = pftrack.Tracker(frame_rate=25.0)
-    tracker.prime(itertools.islice(iter(FrameSource(folder / video)), 30))
-    for n, frame in enumerate(FrameSource(folder / video), start=1):
+    tracker.prime(itertools.islice(iter(FrameSource(source)), 30))
+    for n, frame in enumerate(FrameSource(source), start=1):
         r = by_frame.get(n, np.zeros((0, 10)))
         dets = np.column_stack([r[:, 2:4] * scale, (r[:, 2:4] + r[:, 4:6]) * scale, r[:, 6]])
         # x2 as the CLI computes it, from the scaled left and width: same floats, same bytes
@@ -95,11 +120,9 @@ def test_documented_loop_is_the_cli_byte_for_byte(name, dtype, tmp_path):
     rows = tracker.finalize()
     api_out = tmp_path / "api.txt"
     write_mot(api_out, rows)
+    # the same bytes, so the same scores: evaluating both (was) could not tell them apart
     assert api_out.read_bytes() == cli_out.read_bytes()
-    gt = read_mot(folder / "gt.txt")
-    a = evaluate_mot(gt, read_mot(api_out), scale=scale)
-    b = evaluate_mot(gt, read_mot(cli_out), scale=scale)
-    assert (a.mota, a.idf1) == (b.mota, b.idf1)
+    assert len(set(rows[:, 1])) >= 4  # people tracked, not a run of no track
 
 
 @pytest.mark.dataset
