@@ -4,8 +4,9 @@ left63's probe (6 December) called each public function of pftrack and its subpa
 None, text, a float NaN, a 3-D array and an empty array for each argument. These failed with
 an AttributeError, an IndexError of NumPy's or a message of several lines (an array's repr);
 pftrack.synthetic's warp_frame failed with OpenCV's assertion over several lines. left64
-(6 December) added ``pftrack.render``'s ``ink_scale`` and ``draw_trails``: AttributeError,
-IndexError, NumPy's "cannot reshape" and "truth value ... ambiguous", OpenCV's assertion.
+(6 December) added ``pftrack.render``'s ``ink_scale``, ``draw_trails`` and ``colour_of``:
+AttributeError, IndexError, NumPy's "cannot reshape", "truth value ... ambiguous" and
+"unhashable type", OpenCV's assertion, "cannot convert float NaN to integer".
 """
 
 from __future__ import annotations
@@ -60,6 +61,7 @@ CALLS: dict[str, tuple[Callable[..., Any], tuple[Any, ...], int]] = {
     "recover_file options": (batch.recover_file, ("t.txt", None), 1),
     "smooth_file options": (batch.smooth_file, ("t.txt", None), 1),
     "ink_scale": (render.ink_scale, ((6, 8, 3),), 0),
+    "colour_of": (render.colour_of, (1,), 0),
     "draw_trails frame": (render.draw_trails, (_CANVAS, _TRAILS), 0),
     "draw_trails trails": (render.draw_trails, (_CANVAS, _TRAILS), 1),
 }
@@ -129,6 +131,9 @@ def test_draw_trails_and_ink_scale_refuse_in_one_line_and_draw_as_before() -> No
     render.draw_trails(crop[5:30, 5:40], trails)  # a crop's rows: drawn into, as before
     assert crop[5:30, 5:40].any() and not crop[:5].any()
     assert [render.ink_scale(s) for s in ([1080, 1920], np.array([2160, 3840, 3]))] == [2, 4]
+    assert render.colour_of(np.int64(7)) == render.colour_of(7) == render.colour_of(7.0)
+    with pytest.raises(ValueError, match="^colour_of: track_id is inf, expected a finite"):
+        render.colour_of(math.inf)
     refused = {
         "read-only": (np.zeros((4, 5, 3), np.uint8), trails),
         "flipped": (np.zeros((4, 5, 3), np.uint8)[:, ::-1], trails),

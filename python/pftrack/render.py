@@ -26,6 +26,7 @@ from pftrack._check import (
     number,
     path_arg,
     real_array,
+    shown,
     text,
 )
 from pftrack._threads import join_through_interrupts
@@ -49,12 +50,29 @@ __all__ = [
 Box = tuple[int, int, int, int]  # a drawn tag's pixels: x0, y0, x1, y1, inclusive
 
 
-@functools.lru_cache(maxsize=4096)
 def colour_of(track_id: int) -> tuple[int, int, int]:
     """A stable, distinct BGR colour for an id (golden-ratio hue steps).
 
     Cached: every drawn frame asks again for the colour of each track, box and trail.
+
+    Raises
+    ------
+    TypeError
+        `track_id` is not a number (text, None, an array).
+    ValueError
+        `track_id` is NaN or infinite.
     """
+    try:  # checked where it fails: the cached call is the per-box path
+        return _colour_of(track_id)
+    except TypeError:  # was: "unhashable type: 'numpy.ndarray'", "can't multiply sequence"
+        raise TypeError(f"colour_of: track_id must be a number, got {shown(track_id)}") from None
+    except (ValueError, OverflowError):  # was: "cannot convert float NaN to integer"
+        raise ValueError(f"colour_of: track_id is {track_id}, expected a finite number") from None
+
+
+@functools.lru_cache(maxsize=4096)
+def _colour_of(track_id: int) -> tuple[int, int, int]:
+    """:func:`colour_of`, unchecked and cached."""
     hue = int((track_id * 0.618033988749895 % 1.0) * 179)
     hsv = np.array([[[hue, 220, 255]]], dtype=np.uint8)
     b, g, r = cv2.cvtColor(hsv, cv2.COLOR_HSV2BGR)[0, 0]
