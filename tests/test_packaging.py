@@ -78,3 +78,18 @@ def test_the_sdist_holds_the_allowed_files_only(tmp_path: Path) -> None:
         assert info is not None
         pkg_info = info.read().decode()
     assert "License-Expression: MIT" in pkg_info and "License-File: LICENSE" in pkg_info
+
+
+def test_a_wheel_and_an_editable_install_build_in_different_folders() -> None:
+    # was "build/{wheel_tag}" for both: `pip install .` after the README's editable install
+    # (-Ceditable.rebuild=true) reconfigured the editable's folder with the isolated build's
+    # pybind11, gone after it, and the editable's rebuild on import failed from then on
+    tomllib = pytest.importorskip("tomllib")  # Python 3.11+
+    text = (REPO / "pyproject.toml").read_text(encoding="utf-8")
+    build_dir = tomllib.loads(text)["tool"]["scikit-build"]["build-dir"]
+    values = {"cache_tag": "cpython-311", "wheel_tag": "cp311-cp311-linux_x86_64"}
+    folders = {
+        state: build_dir.format(build_type="Release", state=state, **values)
+        for state in ("wheel", "editable", "sdist")
+    }
+    assert folders["wheel"] != folders["editable"], folders
