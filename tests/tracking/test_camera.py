@@ -368,6 +368,40 @@ def test_a_moving_camera_is_measured_against_key_frames(
     assert calls[0] == 119
 
 
+def test_steps_made_every_frame_are_the_dataclass_s(texture: np.ndarray) -> None:
+    # CameraMotion.update makes its CameraStep without the frozen dataclass's __init__
+    # (speed): the object must be the one CameraStep(...) makes, every field set, pickled to
+    # the same bytes, and still frozen
+    import dataclasses
+    import pickle
+
+    from pftrack.tracking.camera import CameraStep, _camera_step
+
+    affine = similarity(1.0, 0.0, 0.2, -0.1)[:2]
+    for values in [(None, 0.0, False, None, True), (affine, 0.31, True, affine, False)]:
+        fast, made = _camera_step(*values), CameraStep(*values)
+        assert type(fast) is CameraStep
+        assert list(vars(fast)) == [f.name for f in dataclasses.fields(CameraStep)]
+        assert list(vars(fast)) == list(vars(made))
+        assert repr(fast) == repr(made)
+        assert pickle.dumps(fast) == pickle.dumps(made)
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            fast.moving = True  # type: ignore[misc]
+    camera = CameraMotion("auto")
+    camera.update(texture)
+    step = camera.update(texture)
+    assert step == CameraStep(*(getattr(step, f.name) for f in dataclasses.fields(CameraStep)))
+
+
+@pytest.mark.parametrize("size", [(360, 480), (576, 720), (720, 1280), (1, 500), (7, 3)])
+def test_the_cached_diagonal_is_numpys_hypot(size: tuple[int, int]) -> None:
+    # the thresholds are shares of this float: it must be np.hypot's, bit for bit
+    from pftrack.tracking.camera import _diagonal
+
+    assert _diagonal(*size) == float(np.hypot(*size))
+    assert type(_diagonal(*size)) is float
+
+
 def test_on_and_off_modes(texture: np.ndarray) -> None:
     on, off = CameraMotion("on"), CameraMotion("off")
     for _ in range(3):

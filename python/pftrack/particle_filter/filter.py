@@ -266,6 +266,8 @@ def _release(filters: Sequence[ColourParticleFilter]) -> None:
 
 def _once(filters: Sequence[object], fn: str) -> None:
     """Each filter at most once in `filters` (a repeat would step it twice on the same arrays)."""
+    if len({id(f) for f in filters}) == len(filters):  # the usual case, without the loop below
+        return
     seen: dict[int, int] = {}
     for k, f in enumerate(filters):
         j = seen.setdefault(id(f), k)

@@ -89,6 +89,24 @@ class CameraStep:
     background_ok: bool
 
 
+def _camera_step(affine: F64 | None, magnitude: float, moving: bool, apply: F64 | None,
+                 background_ok: bool) -> CameraStep:  # fmt: skip
+    """``CameraStep(affine, ...)``, made without the frozen dataclass's ``__init__``.
+
+    A frozen dataclass sets each field through ``object.__setattr__`` (about 1.5 us for the
+    five; :func:`pftrack.tracking.track._new_track` does the same for ``Track``), and
+    ``"auto"`` makes one every frame. The same object: its fields in the same order in its
+    ``__dict__``, equal, pickled to the same bytes (tests/tracking/test_camera_motion.py).
+    CameraStep has no ``__post_init__`` to run.
+    """
+    step = object.__new__(CameraStep)
+    step.__dict__.update(
+        affine=affine, magnitude=magnitude, moving=moving, apply=apply,
+        background_ok=background_ok,
+    )  # fmt: skip
+    return step
+
+
 def compose(second: F64, first: F64) -> F64:
     """The affine doing `first`, then `second` (both (2, 3))."""
     return np.hstack([second[:, :2] @ first[:, :2], second[:, :2] @ first[:, 2:] + second[:, 2:]])
@@ -116,6 +134,16 @@ def motion_magnitude(affine: ArrayLike, size: tuple[int, int]) -> float:
     corners = _image_corners(size[0], size[1])
     moved = corners @ a[:, :2].T + a[:, 2]
     return float(np.hypot(*(moved - corners).T).max())
+
+
+@functools.lru_cache(maxsize=16)
+def _diagonal(h: int, w: int) -> float:
+    """``float(np.hypot(h, w))``, the diagonal of an `h` x `w` image, once per size.
+
+    The same float (NumPy's ``hypot``, not ``math.hypot``, which may round otherwise); NumPy's
+    scalar call on two ints took about 1.5 us of every :meth:`CameraMotion.update`.
+    """
+    return float(np.hypot(h, w))
 
 
 @functools.lru_cache(maxsize=16)
@@ -389,7 +417,7 @@ class CameraMotion:
         affine = None
         magnitude = 0.0
         size = (frame.shape[0], frame.shape[1])
-        diagonal = float(np.hypot(*size))
+        diagonal = _diagonal(*size)
         if prev is not None and prev.shape == grey.shape:
             still = self._still(prev, grey, factor, size, diagonal)
             if still is not None:
@@ -433,7 +461,7 @@ class CameraMotion:
             if self._since_moving < cfg.settle_frames:
                 self._since_moving += 1
         background_ok = not self.moving and self._since_moving >= cfg.settle_frames
-        return CameraStep(affine, magnitude, self.moving, apply, background_ok)
+        return _camera_step(affine, magnitude, self.moving, apply, background_ok)
 
     def _keyed(self, prev: NDArray[np.uint8], grey: NDArray[np.uint8], factor: float,
                exclude: F64) -> tuple[F64, NDArray[np.float32]] | None:  # fmt: skip

@@ -760,7 +760,7 @@ class MultiObjectTracker:
         if rank is not None:
             index = rank[index]  # the caller's row of each box
         if given is not None:
-            self.tiny_given += int(tiny.sum())
+            self.tiny_given += np.count_nonzero(tiny)  # (ndarray.sum: a Python wrapper)
             self.kept_given += len(index)
         elif len(tiny):  # the built-in detector's boxes, before min_score
             self.found_own += len(tiny)
