@@ -445,6 +445,29 @@ void register_detection(py::module_& m) {
         "New BinnedImage with bins -1 where mask (H, W) uint8/bool is 0 (background).");
 
     m.def(
+        "sampled_mean",
+        [](const py::object& frame_in, Index step) {
+            const char* fn = "sampled_mean";
+            const py::array frame =
+                bind::ndarray(frame_in, fn, "frame", "(H, W, 3) uint8 (BGR, as cv2 reads it)");
+            if (!bind::is_u8(frame.dtype()))
+                throw py::type_error(std::string(fn) + ": frame dtype is " +
+                                     bind::dtype_name(frame) + ", expected uint8");
+            if (!(frame.ndim() == 3 && frame.shape(2) == 3))
+                fail(fn, "frame must have shape (H, W, 3), got " + shape_str(frame));
+            if (!(frame.shape(0) > 0 && frame.shape(1) > 0)) fail(fn, "frame is empty");
+            require(step >= 1, fn, "step", static_cast<double>(step), ">= 1");
+            // any strides (a view such as frame[:, :, ::-1] too); the GIL kept: a few
+            // microseconds, and the caller's array cannot change under it
+            return sampled_mean(static_cast<const std::uint8_t*>(frame.data()), frame.shape(0),
+                                frame.shape(1), frame.strides(0), frame.strides(1),
+                                frame.strides(2), step);
+        },
+        py::arg("frame"), py::arg("step"),
+        "Mean level of every step-th pixel of every step-th row of a (H, W, 3) uint8 frame "
+        "(numpy's frame[::step, ::step].mean(), the same double).");
+
+    m.def(
         "close_mask",
         [](const py::object& mask, const py::object& element) {
             return mask_pass(mask, element, "close_mask", close_mask);

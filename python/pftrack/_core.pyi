@@ -227,6 +227,10 @@ def hsv_bins(
 def median_frames(frames: Sequence[NDArray[np.uint8]], threads: int = 1) -> NDArray[np.float32]: ...
 def mask_bins(binned: BinnedImage, mask: NDArray[Any]) -> BinnedImage: ...  # mask (H, W)
 
+# mean level of every step-th pixel of every step-th row of a (H, W, 3) uint8 frame, any
+# strides: numpy's frame[::step, ::step].mean(), the same double
+def sampled_mean(frame: NDArray[np.uint8], step: int) -> float: ...
+
 # closing of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are single runs,
 # as cv2.morphologyEx(MORPH_CLOSE) -> new (H, W) uint8
 def close_mask(mask: NDArray[Any], element: NDArray[Any]) -> NDArray[np.uint8]: ...

@@ -519,6 +519,25 @@ def test_is_dark() -> None:
     assert is_dark(frame // 2) and is_dark(np.zeros((36, 48, 3), np.uint8))
 
 
+@pytest.mark.parametrize("shape", [(1, 1), (36, 48), (37, 53), (360, 480)])
+def test_sampled_mean_is_numpys_strided_mean_bit_for_bit(shape: tuple[int, int]) -> None:
+    """`_core.sampled_mean` (is_dark's mean) against ``frame[::step, ::step].mean()``: the same
+    double, at every step and over views of any strides (reversed channels, rows, columns)."""
+    rng = np.random.default_rng(sum(shape))
+    frame = rng.integers(0, 256, (*shape, 3), dtype=np.uint8)
+    bright = np.full((*shape, 3), 255, np.uint8)  # the largest sums
+    for f in (frame, frame[:, :, ::-1], frame[::-1], frame[:, ::-3], bright):
+        for step in (1, 2, 3, 4, 7, 8, 1000):
+            assert _core.sampled_mean(f, step) == float(f[::step, ::step].mean())
+    assert is_dark(frame, 2**31 - 1) == (float(frame[0, 0].mean()) <= 8.0)
+    with pytest.raises(ValueError, match="is_dark: step is 0"):
+        is_dark(frame, 0)
+    with pytest.raises(ValueError, match="sampled_mean: step"):
+        _core.sampled_mean(frame, 0)
+    with pytest.raises(TypeError, match="sampled_mean: frame dtype"):
+        _core.sampled_mean(frame.astype(np.uint16), 1)
+
+
 def test_is_blank_is_one_flat_level_not_a_dark_picture() -> None:
     zeros = np.zeros((36, 48, 3), np.uint8)
     assert is_blank(zeros) and is_blank(np.full_like(zeros, 255))  # white is blank, not dark

@@ -522,6 +522,7 @@ TARGETS: list[Target] = [
         ),
     ),  # fmt: skip
     Target("mask_bins", call(_core.mask_bins, maybe(binned()), maybe(masks()))),
+    Target("sampled_mean", call(_core.sampled_mean, maybe(frames()), maybe(ints(-2, 64)))),
     Target("close_mask", _mask_pass(_core.close_mask)),
     Target("open_mask", _mask_pass(_core.open_mask)),
     Target(

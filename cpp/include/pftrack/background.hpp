@@ -778,6 +778,28 @@ inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index row
     hsv_bins_image(lut, bgr, rows, cols, row_stride, mask, mask_stride, out, cols);
 }
 
+/// The mean level of every `step`-th pixel of every `step`-th row, over its three channels:
+/// numpy's ``frame[::step, ::step].mean()`` as the same double (its float64 sum of these
+/// integers is exact in any order, below 2^53, and is divided by the count as here). Any
+/// strides, in bytes (rows `s_row`, pixels `s_px`, channels `s_ch`; negative ones too).
+/// The light's darkness test of every frame (python/pftrack/detection/light.py `is_dark`):
+/// about a tenth of NumPy's strided reduction's time.
+inline double sampled_mean(const std::uint8_t* bgr, Index rows, Index cols, Index s_row,
+                           Index s_px, Index s_ch, Index step) {
+    std::int64_t sum = 0;
+    for (Index y = 0; y < rows; y += step) {
+        const std::uint8_t* row = bgr + y * s_row;
+        std::int64_t s = 0;
+        for (Index x = 0; x < cols; x += step) {
+            const std::uint8_t* p = row + x * s_px;
+            s += static_cast<std::int64_t>(p[0]) + p[s_ch] + p[2 * s_ch];
+        }
+        sum += s;
+    }
+    const Index n = ((rows - 1) / step + 1) * ((cols - 1) / step + 1) * 3;  // rows, cols >= 1
+    return static_cast<double>(sum) / static_cast<double>(n);
+}
+
 /// Bins with background set to -1: out = mask == 0 ? -1 : bins.
 inline void mask_bins(const std::int16_t* bins, Index rows, Index cols, const std::uint8_t* mask,
                       Index mask_stride, std::int16_t* out) {

@@ -34,7 +34,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pftrack._check import shown
+from pftrack import _core
+from pftrack._check import integer, shown
 from pftrack._stats import median, percentile
 from pftrack.detection.base import check_frame
 
@@ -59,6 +60,9 @@ GREY_SAMPLE_STEP = 4
 GAIN_SAMPLE_STEP = 8
 """The step of the detector's per-frame gain (``BackgroundModel.global_gain``) up to 640x480:
 4 800 samples there, 0.026 ms a 480x360 frame against 0.096 ms at every 4th pixel."""
+
+_MAX_STEP = 2**31 - 1
+"""Largest sampling step :func:`is_dark` takes (any frame's side is smaller)."""
 
 _STEP_PIXELS = 640 * 480
 """Frames larger than this are sampled more sparsely (:func:`sample_step`)."""
@@ -95,8 +99,12 @@ def is_dark(frame: NDArray[np.uint8], step: int | None = None) -> bool:
         Sampling step in rows and columns (default: :func:`sample_step` of the frame).
     """
     frame = check_frame(frame, "is_dark")  # was: an AttributeError of None, text, a number
-    step = sample_step(frame.shape) if step is None else step
-    return float(frame[::step, ::step].mean()) <= DARK_LEVEL
+    step = (
+        sample_step(frame.shape) if step is None else integer(step, "is_dark: step", 1, _MAX_STEP)
+    )
+    # frame[::step, ::step].mean()'s value in C++ (the same double, at any strides): a tenth
+    # of NumPy's strided reduction's time, and the detector asks it of every frame
+    return _core.sampled_mean(frame, step) <= DARK_LEVEL
 
 
 BLANK_LEVELS = 2
