@@ -3233,16 +3233,64 @@ def test_the_workers_are_counted_by_the_scheduler_not_a_stale_cache(
 
 
 def _close_my_worker(k: int) -> TaskResult:
-    """A task that closes its worker (and the worker's nanny) and returns a moment later."""
+    """A task that closes its worker (and the worker's nanny) and returns once it is closing.
+
+    Closing, the worker takes no other task: the others wait for a worker. Was: returned after
+    0.3 s, however far the close had gone, so that on a loaded machine (load 20) the worker
+    could take a next task before it closed.
+    """
     worker = distributed.get_worker()
     worker.loop.add_callback(worker.close, nanny=True, reason="test: workers lost")
-    time.sleep(0.3)
+    deadline = time.monotonic() + 120  # a bound against a hang, not a timing
+    while worker.status == distributed.core.Status.running and time.monotonic() < deadline:
+        time.sleep(0.01)
     return TaskResult(np.zeros((0, 10)), {}, {"k": k})
+
+
+class _LastWorkerGone(distributed.diagnostics.plugin.SchedulerPlugin):
+    """On a local cluster's scheduler (in this process): when its last worker left.
+
+    `then` is called then, on the scheduler's event loop. The tests time the batch's wait for
+    a worker from this moment, not from the batch's start: the cluster's start and the batch's
+    checks took most of a 15 s limit on a machine at load 20.
+    """
+
+    def __init__(self, then: Any = None) -> None:
+        self.at: float | None = None
+        self.then = then
+
+    def remove_worker(self, scheduler: Any, worker: str, **kwargs: Any) -> None:
+        if not scheduler.workers and self.at is None:
+            self.at = time.monotonic()
+            if self.then is not None:
+                self.then()
+
+    def since(self) -> float:
+        """Seconds since the last worker left (the test fails if none has)."""
+        assert self.at is not None, "the workers were never lost: no test"
+        return time.monotonic() - self.at
+
+
+def _watch_last_worker(cluster: Any, then: Any = None) -> _LastWorkerGone:
+    """A :class:`_LastWorkerGone` added to `cluster`'s scheduler, on its event loop."""
+    gone = _LastWorkerGone(then)
+
+    async def add() -> None:
+        cluster.scheduler.add_plugin(gone)
+
+    cluster.sync(add)
+    return gone
+
+
+#: Seconds a batch's wait for its lost workers may take in the tests where Dask's
+#: no-workers-timeout is 1 s: far below Dask's own default (60 s, the batch's too) and for ever,
+#: far above the 1 s and the watch's counts, once a second, on a loaded machine.
+LOST_WAIT_BOUND = 30.0
 
 
 @pytest.mark.parametrize("setting_on_the_scheduler", [False, True])
 def test_workers_lost_mid_run_fail_the_tasks_left(
-    tmp_path: Path, setting_on_the_scheduler: bool
+    tmp_path: Path, setting_on_the_scheduler: bool, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Every worker gone mid-run: the batch waited forever for the tasks left.
 
@@ -3251,6 +3299,10 @@ def test_workers_lost_mid_run_fail_the_tasks_left(
     """
     import dask
 
+    import pftrack.batch.engine as engine
+
+    # the scheduler (this process's) slow to answer at load 20 is not what is tested here
+    monkeypatch.setattr(engine, "ANSWER_WAIT", LOST_WAIT_BOUND)
     jobs = [Job("first", _close_my_worker, (0,), ()), *(Job(f"slow{k}", _slow, (k,), ())
                                                         for k in range(2))]  # fmt: skip
     setting = {"distributed.scheduler.no-workers-timeout": "1s"}
@@ -3263,11 +3315,13 @@ def test_workers_lost_mid_run_fail_the_tasks_left(
         ))  # fmt: skip
         stack.enter_context(dask.config.set(setting))
         address = cluster.scheduler_address
-        start = time.monotonic()
+        gone = _watch_last_worker(cluster)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             summary = run_jobs(jobs, tmp_path, kind="smooth", settings={}, scheduler=address)
-        assert time.monotonic() - start < 15
+        # the wait of 1 s, from the loss (was: < 15 s from the batch's start, its cluster's
+        # start and checks included, which a machine at load 20 exceeded)
+        assert gone.since() < LOST_WAIT_BOUND
     if not setting_on_the_scheduler:  # this process saw them go
         said = [str(w.message) for w in caught]
         assert said == [f"the scheduler at {address} has lost all its workers; waiting up to "
@@ -3325,7 +3379,9 @@ def test_the_summary_counts_the_workers_that_ran_its_tasks(tmp_path: Path) -> No
     assert json.loads((tmp_path / "out" / "summary.json").read_text())["workers"] == 2
 
 
-def test_a_worker_without_pftrack_that_joins_mid_run_is_named(tmp_path: Path) -> None:
+def test_a_worker_without_pftrack_that_joins_mid_run_is_named(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """A trial: the workers lost mid-run, the operator started one from an environment without
     pftrack. It joined, was given a task it could not unpickle and died at once, too soon for
     the count of the workers to see it; the tasks left failed after the wait saying "start
@@ -3335,7 +3391,18 @@ def test_a_worker_without_pftrack_that_joins_mid_run_is_named(tmp_path: Path) ->
     dask_cmd = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.which("dask")
     if dask_cmd is None:
         pytest.skip("the dask command is not installed")
-    (tmp_path / "hide_pftrack.py").write_text(HIDE_PFTRACK)
+    import pftrack.batch.engine as engine
+
+    # the scheduler (this process's) slow to answer at load 20 is not what is tested here
+    monkeypatch.setattr(engine, "ANSWER_WAIT", LOST_WAIT_BOUND)
+    ready, go = tmp_path / "ready", tmp_path / "go"
+    # the worker without pftrack: started (Dask imported) before the batch, and held before it
+    # connects until the batch's workers are lost, as an operator would start it then (was: a
+    # timer of 2 s from the test's start, and the worker's start within the 15 s wait: at load
+    # 20 it joined before the loss, or after the wait)
+    (tmp_path / "hide_pftrack.py").write_text(
+        HIDE_PFTRACK + HELD.format(ready=str(ready), go=str(go))
+    )
     jobs = [Job("first", _close_my_worker, (0,), ()), *(Job(f"slow{k}", _slow, (k,), ())
                                                         for k in range(2))]  # fmt: skip
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
@@ -3349,16 +3416,14 @@ def test_a_worker_without_pftrack_that_joins_mid_run_is_named(tmp_path: Path) ->
         cmd = [dask_cmd, "worker", address, "--nthreads", "1", "--no-nanny", "--no-dashboard",
                "--preload", str(tmp_path / "hide_pftrack.py")]  # fmt: skip
         log = stack.enter_context((tmp_path / "log.txt").open("w"))
-        procs: list[subprocess.Popen[bytes]] = []
-
-        def start() -> None:  # once the batch runs, as an operator would, its workers lost
-            procs.append(subprocess.Popen(cmd, stdout=log, stderr=log, env=env, cwd=tmp_path))
-
-        timer = threading.Timer(2.0, start)
-        timer.start()
-        stack.callback(lambda: [p.wait(15) for p in procs])
-        stack.callback(lambda: [p.kill() for p in procs])
-        stack.callback(timer.join)
+        proc = subprocess.Popen(cmd, stdout=log, stderr=log, env=env, cwd=tmp_path)
+        stack.callback(proc.wait, 15)
+        stack.callback(proc.kill)
+        deadline = time.monotonic() + 300  # a bound against a hang, not a timing
+        while not ready.exists() and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert ready.exists(), (tmp_path / "log.txt").read_text()
+        _watch_last_worker(cluster, then=go.touch)  # the workers lost: it connects
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             summary = run_jobs(jobs, tmp_path / "out", kind="smooth", settings={},
@@ -3379,6 +3444,16 @@ def test_a_worker_without_pftrack_that_joins_mid_run_is_named(tmp_path: Path) ->
             rf"lost before this file ran or finished; {named} \(a re-run does the rest\)",
             e["error"],
         ), e["error"]
+
+
+#: The end of a worker's preload: it says it is ready, then holds the worker (before it
+#: connects to its scheduler) until the file `go` exists; 10 minutes at most.
+HELD = """import os, time
+open({ready!r}, "w").close()
+_deadline = time.monotonic() + 600
+while not os.path.exists({go!r}) and time.monotonic() < _deadline:
+    time.sleep(0.02)
+"""
 
 
 HIDE_PFTRACK_ONCE = """import os, sys
@@ -4048,7 +4123,12 @@ def test_a_result_lost_with_the_last_worker_is_not_waited_for_for_ever(
     wait is bounded and watched like the others: the task fails after the wait for a worker."""
     import dask
 
+    import pftrack.batch.engine as engine
+
+    # the scheduler (this process's) slow to answer at load 20 is not what is tested here
+    monkeypatch.setattr(engine, "ANSWER_WAIT", LOST_WAIT_BOUND)
     unbounded: list[object] = []
+    lost: list[float] = []  # when its worker was gone
     real = distributed.Future.result
 
     def result(self: Any, timeout: Any = None) -> Any:
@@ -4057,10 +4137,11 @@ def test_a_result_lost_with_the_last_worker_is_not_waited_for_for_ever(
             if not unbounded:  # the first look: its worker dies now, before the gather
                 unbounded.append(timeout)
                 self.client.run(_close_worker)
-                deadline = time.monotonic() + 10
+                deadline = time.monotonic() + 120  # a bound against a hang, not a timing
                 while cluster.scheduler.workers and time.monotonic() < deadline:
                     time.sleep(0.05)
                 assert not cluster.scheduler.workers
+                lost.append(time.monotonic())
             if timeout is None:  # the code before: waited for ever, here 10 s then failed
                 unbounded.append(None)
                 timeout = 10
@@ -4075,14 +4156,16 @@ def test_a_result_lost_with_the_last_worker_is_not_waited_for_for_ever(
         ))  # fmt: skip
         stack.enter_context(dask.config.set(setting))
         address = cluster.scheduler_address
-        start = time.monotonic()
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             summary = run_jobs(
                 [Job("first", _empty, (0,), ())], tmp_path, kind="smooth", settings={},
                 scheduler=address,
             )  # fmt: skip
-        took = time.monotonic() - start
+        # from the loss (was: < 10 s from the batch's start, the cluster's checks included,
+        # which a machine at load 20 exceeded): the wait of 1 s, not the 10 s of an unbounded
+        # result() above, nor for ever
+        took = time.monotonic() - lost[0]
     assert unbounded and None not in unbounded, "the result was waited for without a bound"
     assert took < 10
     assert [str(w.message) for w in caught] == [
