@@ -520,6 +520,33 @@ def test_the_local_clusters_loops_are_slowed(client: Any) -> None:
     assert _loops() == SLOWER_LOOPS
 
 
+def test_tasks_go_to_the_cluster_largest_first(
+    client: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Dask runs tasks in the order they were submitted: a long sequence given last ran alone at
+    the end while the other workers idled. The most bytes read go first, ties as given; the
+    summary keeps the input order."""
+    import pftrack.batch.engine as engine
+
+    sizes = {"a": 10, "b": 1000, "c": 100, "d": 1000, "e": 0}
+    for name, size in sizes.items():
+        (tmp_path / f"{name}.in").write_bytes(b"x" * size)
+    jobs = [Job(name, _empty, (0,), (tmp_path / f"{name}.in",)) for name in sizes]
+    jobs.append(Job("gone", _empty, (0,), (tmp_path / "gone.in",)))  # missing: 0 bytes
+    sent: list[str] = []
+    real = engine._run_on_dask
+
+    def run_on_dask(c: Any, pending: Any, *args: Any, **kwargs: Any) -> None:
+        sent.extend(job.name for job in pending)
+        real(c, pending, *args, **kwargs)
+
+    monkeypatch.setattr(engine, "_run_on_dask", run_on_dask)
+    summary = run_jobs(jobs, tmp_path / "out", kind="smooth", settings={}, client=client)
+    assert sent == ["b", "d", "c", "a", "e", "gone"]
+    assert [e["name"] for e in summary.entries] == [*sizes, "gone"]
+    assert {e["status"] for e in summary.entries} == {"done"}
+
+
 def _bars_drawn() -> TaskResult:
     """Whether a progress bar asked for here would be drawn on a terminal (as a task sees it)."""
     from pftrack import _progress
