@@ -547,6 +547,33 @@ def test_tasks_go_to_the_cluster_largest_first(
     assert {e["status"] for e in summary.entries} == {"done"}
 
 
+_NO_EVAL_IMPORT = """import os, sys
+os.environ["PFTRACK_TRACKING_THREADS"] = "0"
+from pftrack.batch._plugin import SingleThreaded
+from pftrack.batch.inputs import find_sequences
+from pftrack.batch.tasks import TrackOptions, track_sequence
+SingleThreaded()._setup()  # as on a worker of a local cluster
+(seq,) = find_sequences([sys.argv[1]])
+assert len(track_sequence(seq, TrackOptions()).rows)
+print(sorted(m for m in sys.modules if m == "pftrack.eval" or m.startswith("scipy.optimize")))
+"""
+
+
+def test_a_worker_imports_no_evaluation_for_a_sequence_without_ground_truth(
+    tmp_path: Path,
+) -> None:
+    """pftrack.eval imports SciPy's optimize: 0.33 s of CPU in each worker of every batch (stop
+    64), for nothing where no sequence has ground truth: the worker plugin imported it as the
+    cluster started, and every track task at its start."""
+    scene = make_scene(n_frames=8, width=160, height=120, n_walkers=2, rng=0)
+    video = scene.write_video(tmp_path / "walk.avi")
+    done = subprocess.run(
+        [sys.executable, "-c", _NO_EVAL_IMPORT, str(video)],
+        capture_output=True, text=True, check=True,
+    )  # fmt: skip
+    assert done.stdout.strip() == "[]", done.stdout + done.stderr
+
+
 def _bars_drawn() -> TaskResult:
     """Whether a progress bar asked for here would be drawn on a terminal (as a task sees it)."""
     from pftrack import _progress
