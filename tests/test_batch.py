@@ -3412,12 +3412,23 @@ def test_workers_lost_mid_run_fail_the_tasks_left(
 
 
 def _where_i_ran(k: int, joined: str) -> TaskResult:
-    """A task of 0.8 s, once the second worker has joined (`joined` exists): 30 s at most."""
-    deadline = time.monotonic() + 30
+    """A task that runs once the second worker has joined (`joined` exists) and, until a task
+    has run on each of two workers, waits for it (60 s at most each, bounds against a hang).
+
+    The tasks were all given to the first worker, the second taking some by Dask's work
+    stealing; was: 0.8 s each, the second worker's share depending on how fast it came up (at
+    load 24 it took none: "the second worker ran none").
+    """
+    address = distributed.get_worker().address
+    folder = Path(joined).parent
+    deadline = time.monotonic() + 60
     while not os.path.exists(joined) and time.monotonic() < deadline:
         time.sleep(0.05)
-    time.sleep(0.8)
-    return TaskResult(np.zeros((0, 10)), {}, {"k": k, "worker": distributed.get_worker().address})
+    (folder / f"ran-{address.rsplit(':', 1)[-1]}").touch()
+    deadline = time.monotonic() + 60
+    while len(list(folder.glob("ran-*"))) < 2 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return TaskResult(np.zeros((0, 10)), {}, {"k": k, "worker": address})
 
 
 def test_the_summary_counts_the_workers_that_ran_its_tasks(tmp_path: Path) -> None:
