@@ -65,8 +65,11 @@ class SingleThreaded(WorkerPlugin):
     def setup(self, worker: Any) -> Coroutine[Any, Any, None] | None:
         """Limit OpenCV to one thread in this worker process, and load the tasks' modules.
 
-        Importing the tracker, the video reader, recovery and evaluation costs about half a
-        second of CPU: done here, while the cluster starts, rather than in the first task.
+        Importing the tracker, the video reader and recovery costs about a quarter of a second
+        of CPU: done here, while the cluster starts, rather than in the first task. Not the
+        evaluation (:mod:`pftrack.eval`, SciPy's optimize: 0.33 s of CPU more in each worker,
+        measured at stop 64), which only a sequence with ground truth needs: its task imports
+        it.
         A failure is also sent to the scheduler as an event on :data:`SETUP_FAILED_TOPIC`
         (awaited: the worker's batched stream would send it too late), then raised (Dask logs
         it on the worker).
@@ -89,7 +92,6 @@ class SingleThreaded(WorkerPlugin):
         one_blas_thread()
 
         os.environ[WORKER_THREADS_VARIABLE] = "0"  # no read-ahead, detector or kernel thread either
-        import pftrack.eval
         import pftrack.io.video
         import pftrack.recovery
         import pftrack.tracking.run  # noqa: F401

@@ -361,7 +361,6 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         :func:`~pftrack.io.mot.write_mot`), the annotated video if asked for, and the figures;
         its `error` is set if the ground truth could not be scored (the rows are still there).
     """
-    from pftrack.eval.sequences import benchmark_of_path
     from pftrack.io.mot import as_written, read_mot
     from pftrack.io.video import FrameSource, info_scale, read_seqinfo
     from pftrack.recovery.linking import check_scored_ids
@@ -431,6 +430,10 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
                     "images' positions; rename the images 1..N in their order and number the "
                     "ground truth's frames alike"
                 )
+            # here, not at the top: pftrack.eval imports SciPy's optimize, 0.33 s of CPU in a
+            # worker, for nothing where no sequence has ground truth (stop 64)
+            from pftrack.eval.sequences import benchmark_of_path
+
             gt = read_mot(seq.gt, what="ground truth")
             check_scored_ids(gt, seq.gt)  # FILE:LINE, as pftrack eval (was: 'row K', 0-based)
             _check_gt_scale(seq, gt, written, gt_scale, frames.width)
