@@ -46,7 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import bgr_array, option
 from pftrack._typing import F64
 from pftrack.tracking.config import CAMERA_MOTION, CameraConfig
-from pftrack.tracking.track import LiveTrack, Track
+from pftrack.tracking.track import LiveTrack, Track, frozen_made
 
 __all__ = [
     "CameraMotion",
@@ -91,20 +91,11 @@ class CameraStep:
 
 def _camera_step(affine: F64 | None, magnitude: float, moving: bool, apply: F64 | None,
                  background_ok: bool) -> CameraStep:  # fmt: skip
-    """``CameraStep(affine, ...)``, made without the frozen dataclass's ``__init__``.
-
-    A frozen dataclass sets each field through ``object.__setattr__`` (about 1.5 us for the
-    five; :func:`pftrack.tracking.track._new_track` does the same for ``Track``), and
-    ``"auto"`` makes one every frame. The same object: its fields in the same order in its
-    ``__dict__``, equal, pickled to the same bytes (tests/tracking/test_camera_motion.py).
-    CameraStep has no ``__post_init__`` to run.
-    """
-    step = object.__new__(CameraStep)
-    step.__dict__.update(
-        affine=affine, magnitude=magnitude, moving=moving, apply=apply,
+    """``CameraStep(affine, ...)`` by :func:`~pftrack.tracking.track.frozen_made` (every frame)."""
+    return frozen_made(
+        CameraStep, affine=affine, magnitude=magnitude, moving=moving, apply=apply,
         background_ok=background_ok,
     )  # fmt: skip
-    return step
 
 
 def compose(second: F64, first: F64) -> F64:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import overload
+from typing import TypeVar, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,6 +25,8 @@ from pftrack.particle_filter import ColourParticleFilter, MHColourParticleFilter
 from pftrack.particle_filter.filter import reinitialise_filters, step_filters_summary
 from pftrack.tracking.config import LifecycleConfig, TrackerConfig
 from pftrack.tracking.motion import CentreKalman
+
+_T = TypeVar("_T")
 
 __all__ = [
     "LiveTrack",
@@ -302,23 +304,30 @@ class LiveTrack:
         )
 
 
+def frozen_made(kind: type[_T], /, **fields: object) -> _T:
+    """``kind(**fields)`` for a frozen dataclass, made without its ``__init__``.
+
+    A frozen dataclass sets each field through ``object.__setattr__`` (3.6 us a Track; 0.9
+    this way), and the tracker makes a Track for every live track and a camera step
+    (:class:`~pftrack.tracking.camera.CameraStep`) on every frame. The same object when
+    `fields` are all of them in their order: its ``__dict__`` in the same order, equal, and
+    pickled to the same bytes (tests/tracking/test_tracker.py, test_camera.py). Only for a
+    class without ``__post_init__``.
+    """
+    made = object.__new__(kind)
+    made.__dict__.update(fields)
+    return made
+
+
 def _new_track(id: int, box_xywh: F64, score: float, detection_index: int | None, age: int,
                time_since_update: int, history: tuple[tuple[int, F64, float], ...],
                detection_box: F64 | None, cls: int) -> Track:  # fmt: skip
-    """``Track(id, box_xywh, ...)``, made without the frozen dataclass's ``__init__``.
-
-    A frozen dataclass sets each field through ``object.__setattr__`` (3.6 us a Track; 0.9
-    this way), and the tracker reports every live track on every frame. The same object: its
-    fields in the same order in its ``__dict__``, equal, and pickled to the same bytes
-    (tests/tracking/test_tracker.py). Track has no ``__post_init__`` to run.
-    """
-    t = object.__new__(Track)
-    t.__dict__.update(
-        id=id, box_xywh=box_xywh, score=score, detection_index=detection_index, age=age,
+    """``Track(id, box_xywh, ...)`` by :func:`frozen_made`."""
+    return frozen_made(
+        Track, id=id, box_xywh=box_xywh, score=score, detection_index=detection_index, age=age,
         time_since_update=time_since_update, history=history, detection_box=detection_box,
         cls=cls,
     )  # fmt: skip
-    return t
 
 
 def predict_tracks(
@@ -349,11 +358,7 @@ def predict_tracks(
     if not tracks:
         return
     # a list (the tracker's) first: isinstance against the Sequence ABC takes about 0.5 us
-    gains: Sequence[float]
-    if isinstance(accel_gain, list) or isinstance(accel_gain, Sequence):
-        gains = accel_gain
-    else:
-        gains = [accel_gain] * len(tracks)
+    gains = accel_gain if isinstance(accel_gain, (list, Sequence)) else [accel_gain] * len(tracks)
     summary = step_filters_summary([t.filter for t in tracks], binned).tolist()
     # Floats, not arrays over the tracks: with a few to tens of tracks, the 30-odd NumPy calls
     # on (K, 1) and (K, 2) arrays cost more than the loop (issue 17). The new positions,
