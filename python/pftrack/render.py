@@ -305,7 +305,7 @@ def draw_trails(
             f"draw_trails: trails must be a mapping of ids to foot points {{id: [(x, y), ...]}}, "
             f"got {type(trails).__name__}"
         )
-    lines = []
+    checked: dict[int, F64] = {}  # every id checked before the first is drawn
     for tid, pts in trails.items():
         number(tid, "draw_trails: trails' id")
         what = f"draw_trails: trails[{tid!r}]"
@@ -314,9 +314,18 @@ def draw_trails(
             raise ValueError(f"{what} has shape {a.shape}, expected (n, 2) points x, y")
         if not np.all(np.abs(a) <= 1e9):
             raise ValueError(f"{what} has NaN, inf or a value beyond ±1e9")
-        lines.append((a, colour_of(tid)))
-    for a, colour in lines:
-        _trail_line(frame, a, colour)
+        checked[tid] = a
+    _draw_trails(frame, checked)
+
+
+def _draw_trails(image: NDArray[np.uint8], trails: Mapping[int, ArrayLike]) -> None:
+    """:func:`draw_trails` of a frame and trails checked already.
+
+    The render worker's, every frame: its trails are the feet of rows that
+    :meth:`TrackRenderer.add` checked (was: every point checked again there, each frame).
+    """
+    for tid, pts in trails.items():
+        _trail_line(image, pts, colour_of(tid))
 
 
 def _foot(box: NDArray[np.float64]) -> tuple[float, float]:
@@ -619,7 +628,7 @@ class TrackRenderer:
         n, frame, rows, trails = job
         # the frame and rows were checked by add (was: checked again here, each frame)
         image = _draw_boxes(frame, rows, f"frame {n}")
-        draw_trails(image, trails)
+        _draw_trails(image, trails)
         self.writer.write(image)
 
     def _work(self) -> None:
