@@ -839,6 +839,24 @@ def test_a_truth_with_a_fractional_id_is_named_by_its_line(data: Path, tmp_path:
     )
 
 
+def test_a_truth_of_no_row_is_refused_as_pftrack_eval_refuses_it(
+    data: Path, tmp_path: Path
+) -> None:
+    """Was scored: every box a false positive, no error (``pftrack eval --gt`` refuses it
+    since stop 64; both read it with :func:`pftrack.io.mot.read_ground_truth`)."""
+    seq = tmp_path / "MOT-01"
+    shutil.copytree(data / "MOT-01", seq)
+    gt = seq / "gt" / "gt.txt"
+    gt.write_text("")
+    summary = track_many(seq, tmp_path / "out", n_workers=0, options=TrackOptions(_config()))
+    (entry,) = summary.entries
+    assert entry["error"] == (
+        f"scoring against {gt} (the tracks are written): ground truth {gt} is empty (0 bytes): "
+        "nothing to score against (a cut download or copy?)"
+    )
+    assert (tmp_path / "out" / "MOT-01.txt").stat().st_size > 0
+
+
 def test_a_truth_with_a_negative_id_is_named_by_its_line(data: Path, tmp_path: Path) -> None:
     """Was ``ground truth has id -5 in frame 1: ids must be >= 0 ...``, without the line,
     where ``pftrack eval`` (and ``recover``) say ``gt.txt:31: id -5 in frame 1 ...``."""

@@ -361,7 +361,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         :func:`~pftrack.io.mot.write_mot`), the annotated video if asked for, and the figures;
         its `error` is set if the ground truth could not be scored (the rows are still there).
     """
-    from pftrack.io.mot import as_written, read_mot
+    from pftrack.io.mot import as_written, read_ground_truth
     from pftrack.io.video import FrameSource, info_scale, read_seqinfo
     from pftrack.recovery.linking import check_scored_ids
     from pftrack.tracking.run import SeqinfoScale, track_path
@@ -434,7 +434,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
             # worker, for nothing where no sequence has ground truth (stop 64)
             from pftrack.eval.sequences import benchmark_of_path
 
-            gt = read_mot(seq.gt, what="ground truth")
+            gt = read_ground_truth(seq.gt)  # one of no row is refused, as by pftrack eval
             check_scored_ids(gt, seq.gt)  # FILE:LINE, as pftrack eval (was: 'row K', 0-based)
             _check_gt_scale(seq, gt, written, gt_scale, frames.width)
             # the benchmark a TrackEval tree's BENCH-SPLIT folder names, as pftrack eval takes it

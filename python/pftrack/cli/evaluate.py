@@ -297,7 +297,7 @@ def run(args: argparse.Namespace) -> int:
         scores_json,
     )
     from pftrack.io.atomic import check_output, staged_outputs
-    from pftrack.io.mot import no_rows, read_mot
+    from pftrack.io.mot import no_rows, read_ground_truth, read_mot
     from pftrack.recovery.linking import check_scored_ids
 
     _check_scales(args.scale or [])
@@ -318,12 +318,7 @@ def run(args: argparse.Namespace) -> int:
     # the frames' bar appeared: reading 2 s, the scale check 3 s, the frames counted 0.7 s)
     with Bar(2 * len(jobs), desc="eval reading", enable=shown, unit="file") as reading:
         for name, seq, path in jobs:  # read and check everything before scoring anything
-            gt = read_mot(seq.gt_path, what="ground truth")
-            if not len(gt):  # was: scored, every result box a false positive, exit 0
-                raise ValueError(
-                    f"ground truth {seq.gt_path} {no_rows(seq.gt_path)}: nothing to score "
-                    "against (a cut download or copy?)"
-                )
+            gt = read_ground_truth(seq.gt_path)  # refused if it holds no row
             if shown:  # off a terminal nothing is counted, as the scorers report nothing
                 reading.set(2 * len(loaded) + 1)
             res = read_mot(path, what="result file")

@@ -262,6 +262,27 @@ def no_rows(path: PathLike) -> str:
     return "is empty (0 bytes)" if empty else "holds no row (only blank or comment lines)"
 
 
+def read_ground_truth(path: PathLike) -> F64:
+    """:func:`read_mot` of a ground truth to score against, refused if it holds no row.
+
+    What ``pftrack eval --gt`` and ``pftrack batch`` read (was: an empty one scored, every
+    result box a false positive, exit 0). A tracks file of no row is read by :func:`read_mot`
+    as a tracker's finding instead.
+
+    Raises
+    ------
+    ValueError
+        As :func:`read_mot`; or the file holds no row (:func:`no_rows` says how).
+    """
+    gt = read_mot(path, what="ground truth")
+    if not len(gt):
+        raise ValueError(
+            f"ground truth {path} {no_rows(path)}: nothing to score against (a cut download "
+            "or copy?)"
+        )
+    return gt
+
+
 #: What a refused first row with a word in it (``frame,id,bb_left,...``) is told.
 HEADER_HINT = " (a header line? delete it, or start it with # to keep it as a comment)"
 #: What a refused first row with a word and an empty first field is told: the header of
