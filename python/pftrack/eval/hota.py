@@ -20,6 +20,7 @@ from pftrack._typing import BenchmarkName
 from pftrack.eval.rows import (  # the scored rows; here too, as before
     BENCHMARKS,
     _mot_iou,
+    check_eval_rows,
     guess_benchmark,
     mot_iou,
     not_parts_message,
@@ -264,6 +265,9 @@ def evaluate_hota(
     """
     check_report(on_progress, "evaluate_hota")
     option(benchmark, "evaluate_hota: benchmark", ("auto", *BENCHMARKS))
+    # named as evaluate_mot names them (was: "ground truth must hold real numbers", no function)
+    gt = check_eval_rows(gt, "evaluate_hota: gt")
+    result = check_eval_rows(result, "evaluate_hota: result")
     if benchmark == "auto":
         benchmark = guess_benchmark(gt)
     g, r = prepare_mot(gt, result, benchmark=benchmark, scale=scale, num_frames=num_frames)

@@ -30,7 +30,7 @@ from pftrack._progress import Report, check_report, part
 from pftrack._typing import BenchmarkName, PathLike
 from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark
 from pftrack.eval.metrics import MotMetrics, check_image_size, combine_mot, evaluate_mot
-from pftrack.eval.rows import BENCHMARKS, _mot_iou, not_parts_message
+from pftrack.eval.rows import BENCHMARKS, _mot_iou, check_eval_rows, not_parts_message
 from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT, TOP, WIDTH
 
 __all__ = [
@@ -571,6 +571,9 @@ def evaluate_sequence(
     check_image_size(image_size, "evaluate_sequence")  # before HOTA's work
     check_report(on_progress, "evaluate_sequence")
     option(benchmark, "evaluate_sequence: benchmark", ("auto", *BENCHMARKS))
+    # named as evaluate_mot names them (was: "ground truth must hold real numbers", no function)
+    gt = check_eval_rows(gt, "evaluate_sequence: gt")
+    result = check_eval_rows(result, "evaluate_sequence: result")
     mark = guess_benchmark(gt) if benchmark == "auto" else benchmark
     h = evaluate_hota(
         gt, result, benchmark=mark, scale=scale, num_frames=num_frames,

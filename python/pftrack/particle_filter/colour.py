@@ -269,6 +269,26 @@ def _reference(ref: ArrayLike, fn: str) -> NDArray[np.float64]:
     return np.ascontiguousarray(r)
 
 
+def _pair(hists: ArrayLike, ref: ArrayLike, fn: str) -> tuple[NDArray[np.float64], ...]:
+    """`hists` and `ref` checked (:func:`_histograms`, :func:`_reference`), and their bins alike.
+
+    Bins that differ name both: a number given as `hists` (a NaN) is refused as one, and a
+    row length other than `ref`'s says whose length `ref` was held to (was the core's ``ref
+    size is 3, expected 1`` for either, a number taken for one 1-bin histogram).
+    """
+    h, r = _histograms(hists, fn), _reference(ref, fn)
+    if r.size and h.shape[1] != r.size:  # an empty ref: the core's own message
+        if np.ndim(hists) == 0:
+            raise ValueError(
+                f"{fn}: hists is one number ({brief(hists)}), expected (K, {r.size}) "
+                f"histograms, one a row, of ref's {r.size} bins"
+            )
+        raise ValueError(
+            f"{fn}: ref size is {r.size}, expected {h.shape[1]}, the length of hists' rows"
+        )
+    return h, r
+
+
 def bhattacharyya_coefficient(hists: ArrayLike, ref: ArrayLike) -> NDArray[np.float64]:
     """``rho = Σ_n sqrt(q*(n) q(n))`` of each row of `hists` (K, B) against `ref` (B,).
 
@@ -304,7 +324,7 @@ def bhattacharyya_coefficient(hists: ArrayLike, ref: ArrayLike) -> NDArray[np.fl
     array([0.70710678, 1.        , 0.        ])
     """
     fn = "bhattacharyya_coefficient"
-    return _core.bhattacharyya_coefficient(_histograms(hists, fn), _reference(ref, fn))
+    return _core.bhattacharyya_coefficient(*_pair(hists, ref, fn))
 
 
 def bhattacharyya_distance(hists: ArrayLike, ref: ArrayLike) -> NDArray[np.float64]:
@@ -342,7 +362,7 @@ def bhattacharyya_distance(hists: ArrayLike, ref: ArrayLike) -> NDArray[np.float
     array([0.5411961, 0.       , 1.       ])
     """
     fn = "bhattacharyya_distance"
-    return _core.bhattacharyya_distance(_histograms(hists, fn), _reference(ref, fn))
+    return _core.bhattacharyya_distance(*_pair(hists, ref, fn))
 
 
 def bhattacharyya_weights(
@@ -383,10 +403,10 @@ def bhattacharyya_weights(
     """
     fn = "bhattacharyya_weights"
     lam = _lam(lam, fn)
-    h = _histograms(hists, fn)
+    h, r = _pair(hists, ref, fn)
     if len(h) == 0:  # box_histograms of no boxes: a coefficient each, but no weights to sum to 1
         raise ValueError(f"{fn}: hists has no rows: weights that sum to 1 need a particle")
-    return _core.bhattacharyya_weights(h, _reference(ref, fn), lam)
+    return _core.bhattacharyya_weights(h, r, lam)
 
 
 def _lam(lam: object, fn: str) -> float:

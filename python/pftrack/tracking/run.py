@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack._check import (
     MAX_FRAME,
+    bgr_frame,
     first_bad_box,
     flag,
     generator,
@@ -343,8 +344,11 @@ def track_frames(
                 )
             if primer:
                 tracker.prime(primer, shape=(frames.height, frames.width, 3))
-        else:  # frames in memory already
-            primer = bootstrap_frames(frames, prime_frames, bootstrap, split=threads)
+        else:  # frames in memory already, checked as the caller gave them (was: "prime frame
+            # dtype is float64", naming prime, which the caller did not call)
+            primer = bootstrap_frames(
+                frames, prime_frames, bootstrap, split=threads, prepare=_source_frame
+            )
             if primer:
                 tracker.prime(primer)
     _refuse_stopped(frames)  # stopped while its bootstrap frames were read
@@ -475,6 +479,11 @@ def _calls_from_here(caller: FrameType | None) -> int:
     while caller is not None and caller.f_globals.get("__name__") == __name__:
         depth, caller = depth + 1, caller.f_back
     return depth
+
+
+def _source_frame(frame: NDArray[np.uint8]) -> NDArray[np.uint8]:
+    """A frame of :func:`track_frames`' in-memory `source` checked, named as the caller's."""
+    return bgr_frame(frame, "track_frames: source frame")
 
 
 def _check_frames(frames: object) -> None:
