@@ -1949,6 +1949,7 @@ class FrameSource:
         self._said_bad: frozenset[int] = frozenset()
         self._folder: Path | None = None  # the folder of an image folder's images
         self._broken: tuple[int, int] | None = None  # an AVI's chunks break off (_avi_break)
+        self._span_ms: float | None = None  # a file's duration by its container (not counted)
         self._cap: Any = None
         self._reading = False  # a thread is inside the live capture's read()
         self._replay: list[NDArray[np.uint8]] = []
@@ -1979,6 +1980,8 @@ class FrameSource:
                 first, header_fps, count = self._open_live()
             else:
                 first, header_fps, count, self.rotation = self._probe_file(self.path)
+                if count > 0 and header_fps > 0:  # OpenCV's estimate is duration x rate
+                    self._span_ms = 1000.0 * count / header_fps
                 self._broken = _avi_break(self.path)
                 streams = _several_video_streams(self.path)
                 if streams:  # OpenCV reads the first, without a word
@@ -2321,12 +2324,18 @@ class FrameSource:
             return self.n_frames
         cap = _file_capture(str(self.path))
         found = 0
+        last_ms: float | None = None  # the last frame's time stamp
         try:
             while cap.grab():
                 found += 1
+                last_ms = float(cap.get(cv2.CAP_PROP_POS_MSEC))
         finally:
             cap.release()
         header = self.counted_frames
+        if not header and found < self.n_frames and not self._warned_short:
+            # fewer than the estimate: by its duration, a Matroska file cut short? (was: the
+            # spread bootstrap's recount took the frames counted as the video's, unsaid)
+            self._warn_frame_count(found, last_ms)
         if found != self.n_frames:
             self.n_frames, self.count_known = found, True
             if header:  # an estimate (Matroska's) is no header count to correct
@@ -2667,7 +2676,7 @@ class FrameSource:
             cap.release()
         self._warn_lost(lost, at_end=True)
         if not self._warned_short:  # read to the end (a stopped reader never gets here)
-            self._warn_frame_count(decoded)
+            self._warn_frame_count(decoded, stamps[-1] if stamps else None)
         if not self._warned_uneven:
             self._warn_uneven(stamps, whole=True)
 
@@ -2828,24 +2837,38 @@ class FrameSource:
             UserWarning,
         )
 
-    def _warn_frame_count(self, decoded: int) -> None:
+    def _warn_frame_count(self, decoded: int, last_ms: float | None = None) -> None:
         """Warn, once, if a video read to its end had other than its header's or seqLength's frames.
 
         A sequence's ``seqLength`` is checked against the frames read only for a video (an image
         folder's count is checked when it is opened): a video's header count may be wrong, and
-        a second decoding pass to count its frames would cost as much as the run.
+        a second decoding pass to count its frames would cost as much as the run. A container
+        without a frame count (Matroska, WebM, MPEG streams) says its duration instead: decoding
+        that stopped more than a second (and 3 frames) before it, by the time stamp `last_ms`
+        of the last frame decoded, is said too (was: a truncated Matroska file tracked to its
+        cut without a word; its frame count, FFmpeg's estimate from the duration and a rate, is
+        no count to hold a variable-rate file to, but the duration holds for any rate).
         """
         said = []
         header = self.counted_frames  # not FFmpeg's estimate (Matroska)
-        if decoded < header:
+        short = decoded < header
+        if short:
             said.append(f"its header says {header}")
+        elif not header and self._span_ms is not None and last_ms is not None and decoded:
+            step = self._span_ms / max(self.n_frames, 1)  # one frame, at the header's rate
+            if self._span_ms - (last_ms + step) > max(3 * step, 1000.0):
+                said.append(
+                    f"its container says {self._span_ms / 1000:.1f} s (frame {decoded} is at "
+                    f"{last_ms / 1000:.1f} s)"
+                )
+                short = True
         seq = self.sequence
         if seq is not None and seq.length is not None and decoded != seq.length:
             said.append(f"{seq.folder / 'seqinfo.ini'} says seqLength={seq.length}")
         if not said:
             return
         self._warned_short = True  # once, not on every pass
-        damaged = ": a truncated or damaged file?" if decoded < header else ""
+        damaged = ": a truncated or damaged file?" if short else ""
         warn_outside(
             f"{self.path} ended after {counted(decoded, 'frame')} but "
             f"{' and '.join(said)}{damaged}",
