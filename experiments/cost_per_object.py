@@ -12,13 +12,18 @@ fresh tracker (seed 0, 100 particles) runs 10 untimed frames (births, start-up),
 * ``no refine``: batched without box refinement, so without the background pass (a fixed
   cost of the frame size) -- the tracker alone.
 
-Wall and this process's CPU time per frame are both given: the machine may be shared. Writes
+Wall and this process's CPU time per frame are both given: the machine may be shared. Run it
+with ``OPENBLAS_NUM_THREADS=1``, as ``pftrack track`` runs (``_threads.one_blas_thread``): from
+about 70 objects on, the association's colour product, (T, 110) by (D, 110), is large enough for
+OpenBLAS to wake its thread pool, whose spinning threads then add 2-3 ms of CPU a frame (stop 65,
+docs/results.md "A crowd of 40+ at 1280x720"), a break in the line that is not the tracker's. Writes
 ``cost_per_object.md`` (table), ``cost_per_object.csv`` and ``cost_per_object.png`` (plot drawn
 with OpenCV) to ``--out``.
 
 Usage (from the repository root)::
 
-    python -m experiments.cost_per_object [--out out/cost_per_object] [--counts 1,10,100]
+    OPENBLAS_NUM_THREADS=1 python -m experiments.cost_per_object [--out out/cost_per_object] \
+        [--counts 1,10,100]
 """
 
 from __future__ import annotations

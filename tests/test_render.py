@@ -667,3 +667,48 @@ def test_a_track_with_a_nan_box_is_named_by_add_itself(tmp_path: Path, threaded:
         renderer.add(np.zeros((40, 60, 3), np.uint8), bad)
     renderer.abort()
     assert not (tmp_path / "v.mp4").exists()
+
+
+def _free_y_searching_all(
+    taken: list[tuple[int, int, int, int]],
+    x0: int,
+    x1: int,
+    y: int,
+    above: int,
+    below: int,
+    rows: int,
+) -> int:
+    """render._free_y as it was before stop 65: every try sorted by its distance from `y`."""
+
+    def free(b: int) -> bool:
+        return all(x1 < t[0] or t[2] < x0 or b + below < t[1] or t[3] < b - above for t in taken)
+
+    inside = range(above, rows - below)
+    tries = [y] + [t[3] + above + 1 for t in taken] + [t[1] - below - 1 for t in taken]
+    return next((b for b in sorted(tries, key=lambda b: abs(b - y)) if b in inside and free(b)), y)
+
+
+def test_a_tag_moves_where_the_search_of_every_try_puts_it() -> None:
+    # a crowd's tags: 60 a frame, many on one another and at the frame's edges, so that the
+    # shortcut (the asked baseline itself, when free and inside) and the sorted search both act
+    from pftrack.render import _free_y
+
+    rng = np.random.default_rng(65)
+    shortcut = moved = 0
+    for _ in range(300):
+        rows = int(rng.integers(40, 200))
+        taken: list[tuple[int, int, int, int]] = []
+        for _ in range(int(rng.integers(0, 60))):
+            x0 = int(rng.integers(-20, 300))
+            y0 = int(rng.integers(-20, rows + 20))
+            taken.append((x0, y0, x0 + int(rng.integers(5, 40)), y0 + int(rng.integers(5, 20))))
+        for _ in range(5):
+            x0 = int(rng.integers(-20, 300))
+            x1 = x0 + int(rng.integers(5, 40))
+            y = int(rng.integers(-20, rows + 20))
+            above, below = int(rng.integers(5, 15)), int(rng.integers(0, 6))
+            want = _free_y_searching_all(taken, x0, x1, y, above, below, rows)
+            assert _free_y(taken, x0, x1, y, above, below, rows) == want
+            shortcut += want == y
+            moved += want != y
+    assert shortcut > 100 and moved > 100  # both ways were taken

@@ -248,6 +248,8 @@ def _free_y(taken: list[Box], x0: int, x1: int, y: int, above: int, below: int, 
         return all(x1 < t[0] or t[2] < x0 or b + below < t[1] or t[3] < b - above for t in taken)
 
     inside = range(above, rows - below)
+    if y in inside and free(y):  # the first try (distance 0): most tags, without the sort
+        return y  # of 2 len(taken) + 1 tries (a crowd's 48 tags: a fifth of drawing a frame)
     tries = [y] + [t[3] + above + 1 for t in taken] + [t[1] - below - 1 for t in taken]
     return next((b for b in sorted(tries, key=lambda b: abs(b - y)) if b in inside and free(b)), y)
 
