@@ -18,6 +18,14 @@
 namespace py = pybind11;
 using namespace pftrack;
 
+// the blends and boxes below are the loops' floats too: no fused multiply-add (as in
+// centre_filter.hpp; GCC contracts in C++ wherever the target has FMA, e.g. PFTRACK_NATIVE)
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#elif defined(__GNUC__)
+#pragma GCC optimize("fp-contract=off")
+#endif
+
 namespace {
 
 /// The attribute names, interned once (made on the first call, the GIL held; never freed: the

@@ -2,9 +2,17 @@
 // constant-velocity Kalman filter of a track's centre, both axes sharing one covariance
 // (p00, p01, p11), stepped one frame at a time (dt = 1). The same operations in the same order
 // as the Python floats of pftrack.tracking.track (predict_tracks, follow_tracks_motion), so the
-// same bits: no fused multiply-add (the core is built as ISO C++, -ffp-contract=off, and for
-// x86-64 without FMA unless PFTRACK_NATIVE), no reassociation.
+// same bits: no reassociation, and no fused multiply-add (GCC contracts a * b + c into one FMA
+// in C++ whenever the target has it, e.g. with PFTRACK_NATIVE; clang within an expression: both
+// are turned off for this header's functions below).
 #pragma once
+
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#elif defined(__GNUC__)
+#pragma GCC push_options
+#pragma GCC optimize("fp-contract=off")
+#endif
 
 namespace pftrack {
 
@@ -45,3 +53,7 @@ inline bool centre_update(CentreState& s, double zx, double zy, double r2) {
 }
 
 }  // namespace pftrack
+
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC pop_options
+#endif
