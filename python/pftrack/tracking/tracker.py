@@ -802,7 +802,7 @@ class MultiObjectTracker:
 
         # 1. every track's particle filter looks at this frame, its centre filter predicts
         gains = [self._gains.get(t.cls, 1.0) for t in self.tracks]  # each class's own
-        predicted = predict_tracks(self.tracks, binned, cfg.motion.colour_noise, gains)
+        predict_tracks(self.tracks, binned, cfg.motion.colour_noise, gains)
 
         # 2. association
         if len(boxes):
@@ -814,8 +814,8 @@ class MultiObjectTracker:
         # one class everywhere (the usual case): every pair is allowed
         one_class = not any(classes_t) and not labels.any()
         result = associate(
-            predicted[:, 4:8],  # the boxes, and their heights (the sizes'), just predicted
-            predicted[:, 7],
+            np.array([t.box for t in tracks]).reshape(-1, 4),
+            np.array([t.size[1] for t in tracks]),
             np.array([t.time_since_update for t in tracks]),
             np.array([t.filter.reference for t in tracks]),
             boxes,
