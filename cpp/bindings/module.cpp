@@ -17,6 +17,7 @@ void register_refine(py::module_& m);
 void register_blobs(py::module_& m);
 void register_text(py::module_& m);
 void register_regions(py::module_& m);
+void register_tracks(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "pftrack's C++ kernels (private: use the pftrack package)";
@@ -33,4 +34,5 @@ PYBIND11_MODULE(_core, m) {
     register_blobs(m);
     register_text(m);
     register_regions(m);
+    register_tracks(m);
 }

@@ -411,6 +411,16 @@ def reseed_batch(
     s_min: float,
     s_max: float,
 ) -> None: ...
+def centre_predict_tracks(
+    tracks: list[Any],
+    summary: ArrayLike,
+    gains: list[float] | tuple[float, ...],
+    colour_noise: float,
+    flat_rho: float,
+) -> _F64: ...
+def centre_follow_tracks(
+    tracks: list[Any], boxes: ArrayLike, detection_noise: float, smooth: bool
+) -> _F64: ...
 def mh_step(
     particles: _F64,
     weights: _F64,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -167,6 +168,48 @@ def _reseed_batch() -> st.SearchStrategy[Any]:
 
     return st.lists(st.integers(0, 6), max_size=3).flatmap(
         lambda ns: call(_core.reseed_batch, **kw(ns))
+    )
+
+
+def _centre_tracks(k: int) -> st.SearchStrategy[list[Any]]:
+    """`k` objects with a LiveTrack's centre-filter attributes, some of them garbage."""
+    motion = st.builds(
+        SimpleNamespace,
+        p=maybe(floats_array((2,), -50, 500)),
+        v=maybe(floats_array((2,), -5, 5)),
+        cov=maybe(st.tuples(fl(0, 50), fl(-5, 5), fl(0, 50))),
+        accel=maybe(fl(0, 1)),
+    )
+    track = st.builds(
+        SimpleNamespace, motion=motion, size=maybe(floats_array((2,), 0.5, 300)),
+        box=st.none(), flat=st.just(False), measured=st.none(), rho=st.just(1.0),
+        age=maybe(ints(1, 100)),
+    )  # fmt: skip
+    return st.lists(track, min_size=k, max_size=k)
+
+
+def _centre_predict() -> st.SearchStrategy[Any]:
+    return st.integers(0, 6).flatmap(
+        lambda k: call(
+            _core.centre_predict_tracks,
+            maybe(_centre_tracks(k)),
+            maybe(floats_array((k, 4), -50, 500)),
+            maybe(st.lists(fl(0, 5), min_size=k, max_size=k)),
+            maybe(fl(0, 2)),
+            maybe(fl(0, 1e-6)),
+        )
+    )
+
+
+def _centre_follow() -> st.SearchStrategy[Any]:
+    return st.integers(0, 6).flatmap(
+        lambda k: call(
+            _core.centre_follow_tracks,
+            maybe(_centre_tracks(k)),
+            maybe(floats_array((k, 4), 0.5, 300)),
+            maybe(fl(0, 2)),
+            maybe(st.booleans()),
+        )
     )
 
 
@@ -587,6 +630,8 @@ TARGETS: list[Target] = [
     Target("mh_step", _mh()),
     Target("sis_step_batch", _sis_batch()),
     Target("reseed_batch", _reseed_batch()),
+    Target("centre_predict_tracks", _centre_predict()),
+    Target("centre_follow_tracks", _centre_follow()),
     Target("linear_sum_assignment", _assignment()),
     Target("association_cost", _association_cost()),
     Target("sparse_assignment", _sparse_assignment()),

@@ -18,6 +18,7 @@ from typing import TypeVar, overload
 import numpy as np
 from numpy.typing import NDArray
 
+from pftrack import _core
 from pftrack._core import BinnedImage
 from pftrack._typing import F64
 from pftrack.boxes import _to_cxcywh
@@ -335,18 +336,18 @@ def predict_tracks(
     binned: BinnedImage,
     colour_noise: float,
     accel_gain: float | Sequence[float] = 1.0,
-) -> None:
+) -> F64:
     """:meth:`LiveTrack.predict` for every track at once.
 
     One C++ call steps all the particle filters (:func:`~pftrack.particle_filter.filter.
-    step_filters`); the centre filters' predict and update then run on plain floats, track by
-    track: the same numbers as calling ``t.predict(binned, colour_noise)`` for each track in
-    turn.
+    step_filters`), and one more the centre filters' predict and update
+    (``_core.centre_predict_tracks``, on the tracks' own attributes): the same numbers as
+    calling ``t.predict(binned, colour_noise)`` for each track in turn.
 
     Parameters
     ----------
     tracks : sequence of LiveTrack
-        Updated in place.
+        Updated in place, each at most once.
     binned : pftrack._core.BinnedImage
         This frame's bins.
     colour_noise : float
@@ -354,77 +355,41 @@ def predict_tracks(
     accel_gain : float or sequence of float
         Multiplies each centre filter's `accel` (:meth:`MultiObjectTracker.motion_gain`): one
         factor for every track, or one per track (each track's class's).
+
+    Returns
+    -------
+    (K, 8) ndarray
+        Per track: the centre filter's position and velocity and the box (xywh), the rows the
+        tracks' ``motion.p``, ``motion.v`` and ``box`` are views of.
     """
     if not tracks:
-        return
+        return np.empty((0, 8))
+    listed = tracks if isinstance(tracks, list) else list(tracks)
     # a list (the tracker's) first: isinstance against the Sequence ABC takes about 0.5 us
-    gains = accel_gain if isinstance(accel_gain, (list, Sequence)) else [accel_gain] * len(tracks)
-    summary = step_filters_summary([t.filter for t in tracks], binned).tolist()
-    # Floats, not arrays over the tracks: with a few to tens of tracks, the 30-odd NumPy calls
-    # on (K, 1) and (K, 2) arrays cost more than the loop (issue 17). The new positions,
-    # velocities and boxes go into one array, whose rows the tracks take.
-    rows = []
-    for t, (zx, zy, rho, rho_max), gain in zip(tracks, summary, gains, strict=True):
-        m = t.motion
-        w, h = t.size.tolist()
-        (px, py), (vx, vy) = m.p.tolist(), m.v.tolist()
-        p00, p01, p11 = _floats(m)
-        q = (m.accel * gain if gain != 1.0 else m.accel) * h
-        q = q * q  # (accel h)²
-        # cv_predict over one frame (dt = 1: its products by dt are exact)
-        px, py = px + vx, py + vy
-        p00, p01, p11 = p00 + 2.0 * p01 + p11 + q / 3.0, p01 + p11 + q / 2, p11 + q
-        t.flat = not rho_max - rho > FLAT_RHO  # colour_evidence (see LiveTrack.blind)
-        if not t.flat:  # a flat likelihood is no measurement
-            r = colour_noise * h
-            px, py, vx, vy, p00, p01, p11 = _cv_update_floats(
-                px, py, vx, vy, p00, p01, p11, zx, zy, r * r
-            )
-        m.cov = (p00, p01, p11)
-        t.measured = None
-        t.rho = rho
-        t.age += 1
-        rows.append((px, py, vx, vy, px - w / 2, py - h / 2, w, h))
-    out = np.array(rows)
-    for t, p, v, box in zip(tracks, out[:, 0:2], out[:, 2:4], out[:, 4:8], strict=True):
-        t.motion.p, t.motion.v, t.box = p, v, box
-
-
-def _floats(motion: CentreKalman) -> tuple[float, float, float]:
-    """A centre filter's covariance, whose entries are floats (the tracker sets them so).
-
-    The tuple itself, typed for mypy: was ``typing.cast(tuple[float, float, float], cov)``,
-    which built the subscripted type on every call (about 1 us; twice a track a frame).
-    """
-    cov: tuple[float, float, float] = motion.cov  # type: ignore[assignment]
-    return cov
-
-
-def _cv_update_floats(px: float, py: float, vx: float, vy: float, p00: float, p01: float,
-                      p11: float, zx: float, zy: float, r2: float
-                      ) -> tuple[float, float, float, float, float, float, float]:  # fmt: skip
-    """:func:`pftrack.kalman.cv_update` of a centre's two axes with the measured ``(zx, zy)``.
-
-    The same floats as ``_cv_update``'s NumPy; returns position, velocity and covariance.
-    """
-    s = p00 + r2
-    k0, k1 = p00 / s, p01 / s
-    ex, ey = zx - px, zy - py
-    return (
-        px + k0 * ex, py + k0 * ey, vx + k1 * ex, vy + k1 * ey,
-        (1 - k0) * p00, (1 - k0) * p01, p11 - k1 * p01,
-    )  # fmt: skip
+    if isinstance(accel_gain, (list, tuple)):
+        gains = accel_gain
+    elif isinstance(accel_gain, Sequence):
+        gains = list(accel_gain)
+    else:
+        gains = [accel_gain] * len(listed)
+    summary = step_filters_summary([t.filter for t in listed], binned)
+    # was a loop over the tracks on plain floats (about 3 us a track): the same floats
+    rows: F64 = _core.centre_predict_tracks(listed, summary, gains, colour_noise, FLAT_RHO)
+    return rows
 
 
 def follow_tracks_motion(
     tracks: Sequence[LiveTrack], boxes_xywh: F64, config: TrackerConfig, smooth: bool
 ) -> None:
-    """:meth:`LiveTrack.follow_motion` for many tracks (the same numbers), on plain floats.
+    """:meth:`LiveTrack.follow_motion` for many tracks (the same numbers), in one core call.
+
+    ``_core.centre_follow_tracks`` updates the centre filters and sets the sizes and boxes on
+    the tracks' own attributes (was a loop over them on plain floats: the same floats).
 
     Parameters
     ----------
     tracks : sequence of LiveTrack
-        Tracks that follow a detection each, updated in place.
+        Tracks that follow a detection each, updated in place, each at most once.
     boxes_xywh : (K, 4) ndarray
         Their detections' boxes.
     config : TrackerConfig
@@ -434,30 +399,9 @@ def follow_tracks_motion(
     """
     if not tracks:
         return
+    listed = tracks if isinstance(tracks, list) else list(tracks)
     b = np.asarray(boxes_xywh, dtype=np.float64).reshape(-1, 4)
-    noise = config.motion.detection_noise
-    rows = []  # one array of the new positions, velocities, sizes and boxes (predict_tracks)
-    for t, (bx, by, bw, bh) in zip(tracks, b.tolist(), strict=True):
-        m = t.motion
-        w, h = t.size.tolist()
-        (px, py), (vx, vy) = m.p.tolist(), m.v.tolist()
-        sigma = noise * h
-        px, py, vx, vy, p00, p01, p11 = _cv_update_floats(
-            px, py, vx, vy, *_floats(m), bx + bw / 2, by + bh / 2, sigma * sigma
-        )
-        m.cov = (p00, p01, p11)
-        w, h = 0.7 * w + 0.3 * bw, 0.7 * h + 0.3 * bh
-        box = (px - w / 2, py - h / 2, w, h) if smooth else (bx, by, bw, bh)
-        rows.append((px, py, vx, vy, w, h, *box, bx, by, bw, bh))
-    out = np.array(rows)
-    for t, row in zip(tracks, out, strict=True):
-        t.motion.p, t.motion.v, t.size, t.box, t.measured = (
-            row[0:2],
-            row[2:4],
-            row[4:6],
-            row[6:10],
-            row[10:14],
-        )
+    _core.centre_follow_tracks(listed, b, config.motion.detection_noise, bool(smooth))
 
 
 def reseed_tracks(
