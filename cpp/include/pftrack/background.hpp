@@ -385,21 +385,32 @@ public:
     /// background sum B_b + B_g + B_r is at least `min_sum`, of (I_b + I_g + I_r) / (B_b + B_g +
     /// B_r), in double (numpy.median's value: the mean of the two middle ratios for an even
     /// count). Most pixels are background, so a global illumination change shows as a gain far
-    /// from 1 while people move it little. 1 when no pixel qualifies.
-    double global_gain(const std::uint8_t* bgr, Index row_stride, Index step, double min_sum) {
+    /// from 1 while people move it little. 1 when no pixel qualifies. With `mean`, also
+    /// `sampled_mean` of the frame at `step` into *mean (the same double; the same grid read
+    /// once: the detector asks both of every frame).
+    double global_gain(const std::uint8_t* bgr, Index row_stride, Index step, double min_sum,
+                       double* mean = nullptr) {
         require(initialized(), "BackgroundModel.global_gain", "the model has no background yet");
         require(step >= 1, "BackgroundModel.global_gain", "step", static_cast<double>(step), ">= 1");
         ratios_.clear();
+        std::int64_t levels = 0;  // every sampled pixel's, as sampled_mean sums them
         for (Index y = 0; y < rows_; y += step) {
             const std::uint8_t* px = bgr + y * row_stride;
             const float* q = background_.data() + y * cols_ * 3;
             for (Index x = 0; x < cols_; x += step) {
+                // the sum of three bytes, exact in int and in double: the same ratio as the sum
+                // taken in double
+                const int si = px[3 * x] + px[3 * x + 1] + px[3 * x + 2];
+                levels += si;
                 const double sb = static_cast<double>(q[x]) + static_cast<double>(q[cols_ + x]) +
                                   static_cast<double>(q[2 * cols_ + x]);
                 if (sb < min_sum || sb <= 0.0) continue;
-                const double si = static_cast<double>(px[3 * x]) + px[3 * x + 1] + px[3 * x + 2];
-                ratios_.push_back(si / sb);
+                ratios_.push_back(static_cast<double>(si) / sb);
             }
+        }
+        if (mean != nullptr) {
+            const Index n = ((rows_ - 1) / step + 1) * ((cols_ - 1) / step + 1) * 3;
+            *mean = static_cast<double>(levels) / static_cast<double>(n);
         }
         const size_t n = ratios_.size();
         if (n == 0) return 1.0;
