@@ -177,6 +177,30 @@ void register_detection(py::module_& m) {
             "Median of sum(frame) / sum(background) over every step-th row and column (pixels "
             "whose background sum is >= min_sum): the frame's global gain.")
         .def(
+            "mean_and_gain",
+            [](BackgroundModel& self, const py::object& frame_in, Index step, double min_sum) {
+                const char* fn = "BackgroundModel.mean_and_gain";
+                const bind::InUse busy(&self, fn);
+                const py::array frame = bind::bgr_image(frame_in, fn, "frame");
+                require(self.initialized(), fn, "the model has no background yet");
+                require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
+                        "frame shape is " + shape_str(frame) + ", expected (" +
+                            std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
+                            ", 3)");
+                require(step >= 1, fn, "step", static_cast<double>(step), ">= 1");
+                const auto* src = static_cast<const std::uint8_t*>(frame.data());
+                const Index stride = frame.strides(0);
+                double mean = 0.0, gain = 0.0;
+                {
+                    py::gil_scoped_release nogil;  // safe: raw buffer held by the caller
+                    gain = self.global_gain(src, stride, step, min_sum, &mean);
+                }
+                return py::make_tuple(mean, gain);
+            },
+            py::arg("frame"), py::arg("step") = 4, py::arg("min_sum") = 30.0,
+            "(sampled_mean(frame, step), global_gain(frame, step, min_sum)) in one read of the "
+            "sampled pixels.")
+        .def(
             "scale",
             [](BackgroundModel& self, double gain) {
                 const bind::InUse busy(&self, "BackgroundModel.scale");

@@ -85,6 +85,11 @@ class BackgroundModel:
     def global_gain(
         self, frame: NDArray[np.uint8], step: int = 4, min_sum: float = 30.0
     ) -> float: ...
+    # (sampled_mean(frame, step), global_gain(frame, step, min_sum)): the same two floats, the
+    # sampled pixels read once
+    def mean_and_gain(
+        self, frame: NDArray[np.uint8], step: int = 4, min_sum: float = 30.0
+    ) -> tuple[float, float]: ...
     # background *= gain (float32, clipped to 255)
     def scale(self, gain: float) -> None: ...
     # threshold bounds [s t_min, s t_max] (at most 255); threshold *= s / old s, clamped

@@ -41,6 +41,8 @@ ENTRIES: dict[str, tuple[Callable[[object], object], str]] = {
                                     "BackgroundModel.blend: frame"),
     "_core.BackgroundModel.global_gain": (lambda f: _model().global_gain(f),
                                           "BackgroundModel.global_gain: frame"),
+    "_core.BackgroundModel.mean_and_gain": (lambda f: _model().mean_and_gain(f),
+                                            "BackgroundModel.mean_and_gain: frame"),
     "_core.BackgroundModel.edge_support": (lambda f: _model().edge_support(f, _MASK, _BOXES),
                                            "BackgroundModel.edge_support: frame"),
     "hsv_bins": (lambda f: hsv_bins(f), "hsv_bins: frame"),

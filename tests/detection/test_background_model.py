@@ -297,6 +297,33 @@ def test_a_copied_model_goes_on_as_the_original(how):
     np.testing.assert_array_equal(a.difference_histogram, b.difference_histogram)
 
 
+def test_a_pickled_state_keeps_the_previous_frame_interleaved():
+    # the model keeps the previous frame planar (B, G, R rows) since stop 65; its state gives
+    # and takes it as the frame's BGR bytes, the layout of every pickle made before
+    rng = np.random.default_rng(11)
+    frames = random_scene(rng, shape=(30, 37), steps=8)
+    model, reference = _core.BackgroundModel(n_learn=2), BackgroundReference(n_learn=2)
+    for f in frames[:4]:
+        model.apply(f)
+        reference.apply(f)
+    state = model.__getstate__()
+    assert state[4] == frames[3].tobytes()  # as the frame: interleaved
+    # a state written as an earlier model wrote it, with another frame as the previous one
+    given = (*state[:4], frames[7].tobytes(), *state[5:])
+    restored = _core.BackgroundModel.__new__(_core.BackgroundModel)
+    restored.__setstate__(given)
+    assert restored.__getstate__() == given
+    reference.previous = frames[7].copy()
+    masks = []
+    for f in frames[4:7]:
+        _, mask = restored.apply(f)
+        np.testing.assert_array_equal(mask, reference.apply(f)[1])
+        np.testing.assert_array_equal(restored.background, reference.background)
+        masks.append(mask)
+    # the previous frame given decided candidates (d_prev): not the true previous frame's masks
+    assert not np.array_equal(masks[0], model.apply(frames[4])[1])
+
+
 def test_a_bad_pickled_state_is_refused():
     model = _core.BackgroundModel.__new__(_core.BackgroundModel)
     with pytest.raises(ValueError, match="^BackgroundModel.__setstate__: state size is 2"):

@@ -32,6 +32,36 @@ def test_an_object_that_walked_and_stopped_is_held_until_the_time_limit():
     assert len(memory.still) == 1  # the size model does not learn from it
 
 
+def _pace(f: int, moves: list[tuple[int, int]]) -> float:
+    """x of an object 3 px a frame during the frames [start, stop) of `moves`, still between."""
+    return 10.0 + 3.0 * sum(max(0, min(f, stop) - start) for start, stop in moves)
+
+
+def test_held_and_still_skip_the_test_only_where_it_finds_nothing():
+    # `_stand_at` (from observe) lets held / still return at once before any object that
+    # walked can have stood STILL_FRAMES: the same boxes as the test of every object (a twin
+    # whose _stand_at is 0, as a memory pickled before it was kept), frame by frame
+    rng = np.random.default_rng(3)
+    fast, full = StopMemory(hold_frames=120), StopMemory(hold_frames=120)
+    skipped = held = still = 0
+    for f in range(420):
+        boxes = [[_pace(f, [(0, 40), (200, 260)]), 50.0, 30.0, 80.0]]  # walks, stands, again
+        if 100 <= f < 330:  # comes, walks, stands, leaves
+            boxes.append([_pace(f, [(100, 150)]) + 200.0, 150.0, 28.0, 76.0])
+        boxes.append([600.0, 40.0, 20.0, 20.0])  # never moves
+        b = np.array(boxes) + rng.normal(0.0, 0.3, (len(boxes), 4))
+        fast.observe(b)
+        full.observe(b)
+        full._stand_at = 0
+        skipped += f + 1 < fast._stand_at
+        np.testing.assert_array_equal(fast.held, full.held)
+        np.testing.assert_array_equal(fast.still, full.still)
+        assert fast.held.shape[1:] == fast.still.shape[1:] == (4,)
+        held += len(fast.held) > 0
+        still += len(fast.still) > 0
+    assert skipped > 50 and held > 100 and still > 100  # both paths taken, boxes found
+
+
 def test_an_object_that_never_moved_is_never_held():
     # a patch of changed light, a ghost: its box stays where it is
     memory = StopMemory(hold_frames=1000)

@@ -69,6 +69,35 @@ def test_global_gain_equals_reference(step: int) -> None:
     assert m.global_gain(np.zeros((8, 8, 3), np.uint8)) == 1.0  # no pixel qualifies
 
 
+@pytest.mark.parametrize("step", [1, 3, 4, 8, 100])
+def test_mean_and_gain_are_sampled_mean_and_global_gain(step: int) -> None:
+    # one read of the sampled pixels for both (the detector's every frame): the same doubles
+    # as the two calls, and as NumPy's mean and the gain's reference
+    rng = np.random.default_rng(step)
+    for shape in ((37, 53), (48, 64), (1, 9)):
+        bg = rng.uniform(0, 255, (*shape, 3)).astype(np.float32)
+        bg[: shape[0] // 4] = 3.0  # dark rows: below min_sum, left out of the gain only
+        frame = np.clip(bg * rng.uniform(0.3, 1.5) + rng.normal(0, 4, bg.shape), 0, 255)
+        frame = frame.astype(np.uint8)
+        m = _core.BackgroundModel()
+        m.set_background(bg)
+        mean, gain = m.mean_and_gain(frame, step)
+        assert mean == _core.sampled_mean(frame, step) == frame[::step, ::step].mean()
+        assert gain == m.global_gain(frame, step)
+        assert gain == pytest.approx(frame_gain(frame, bg, step), rel=0, abs=1e-12)
+        left = frame[:, : shape[1] // 2 + 1]  # columns of a larger frame: its row stride
+        m.set_background(np.ascontiguousarray(bg[:, : left.shape[1]]))
+        assert m.mean_and_gain(left, step) == (left[::step, ::step].mean(),
+                                               m.global_gain(left, step))  # fmt: skip
+    m = _core.BackgroundModel()
+    m.set_background(np.zeros((8, 8, 3), np.float32))
+    assert m.mean_and_gain(np.full((8, 8, 3), 7, np.uint8)) == (7.0, 1.0)  # no pixel qualifies
+    with pytest.raises(ValueError, match="^BackgroundModel.mean_and_gain: step is 0"):
+        m.mean_and_gain(np.zeros((8, 8, 3), np.uint8), 0)
+    with pytest.raises(ValueError, match="no background yet"):
+        _core.BackgroundModel().mean_and_gain(np.zeros((8, 8, 3), np.uint8))
+
+
 def test_frame_gain_of_uint8_frames_is_numpys_reduction_bit_for_bit() -> None:
     """The sums of uint8 channels are added as slices (exact integers): the same floats."""
     from pftrack.detection.light import _pixel_sums

@@ -504,6 +504,7 @@ def _background(
         out = model.apply(frames_[-1], hold=mask)  # a tracked object's pixels not learnt
         model.blend(frames_[-1], mask, rate)  # ghosts learnt faster (after the last frame)
         support = model.edge_support(frames_[-1], mask, boxes)  # the ghost test
+        support = (support, model.mean_and_gain(frames_[-1]))  # the light's two measures
     return None if out is None else (out[0].bins, out[1], model.threshold, support)
 
 

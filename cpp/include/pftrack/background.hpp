@@ -233,23 +233,24 @@ PFTRACK_VECTOR_CLONES static void background_row_scan(
     background_row_candidates(n, fb, fg, fr, qb, qg, qr, dprev, t, t_low, sh, di, cand, m);
 }
 
-/// One row of BGR bytes (and of the previous frame) -> float planes b, g, r and
-/// d_prev = max_c |I_c - I'_c|; the row is then copied into the previous frame.
-PFTRACK_VECTOR_CLONES static void background_row_split(Index n, const std::uint8_t* __restrict px,
-                                                       std::uint8_t* __restrict prev,
-                                                       float* __restrict fb, float* __restrict fg,
-                                                       float* __restrict fr,
-                                                       float* __restrict dprev) {
+/// One row of BGR bytes -> float planes b, g, r and d_prev = max_c |I_c - I'_c| against the
+/// previous frame's row, kept planar (B, G, R rows of bytes: read at unit stride, so only the
+/// frame is deinterleaved); the row's bytes then become the previous frame's.
+PFTRACK_VECTOR_CLONES static void background_row_split(
+    Index n, const std::uint8_t* __restrict px, std::uint8_t* __restrict pb,
+    std::uint8_t* __restrict pg, std::uint8_t* __restrict pr, float* __restrict fb,
+    float* __restrict fg, float* __restrict fr, float* __restrict dprev) {
     for (Index x = 0; x < n; ++x) {
         const int b = px[3 * x], g = px[3 * x + 1], r = px[3 * x + 2];
-        const int pb = prev[3 * x], pg = prev[3 * x + 1], pr = prev[3 * x + 2];
         fb[x] = static_cast<float>(b);
         fg[x] = static_cast<float>(g);
         fr[x] = static_cast<float>(r);
-        dprev[x] = static_cast<float>(
-            std::max(std::abs(b - pb), std::max(std::abs(g - pg), std::abs(r - pr))));
+        dprev[x] = static_cast<float>(std::max(
+            std::abs(b - pb[x]), std::max(std::abs(g - pg[x]), std::abs(r - pr[x]))));
+        pb[x] = static_cast<std::uint8_t>(b);
+        pg[x] = static_cast<std::uint8_t>(g);
+        pr[x] = static_cast<std::uint8_t>(r);
     }
-    std::memcpy(prev, px, static_cast<size_t>(3 * n));
 }
 
 /// `background_row_update` with a hold row: a = 0 where cand and hold != 0 (a tracked
@@ -298,9 +299,9 @@ PFTRACK_VECTOR_CLONES static void background_row_update(
 /// histogram with linear interpolation inside its bin: a robust noise level, since most pixels
 /// are background. The first frame's threshold is t_min.
 ///
-/// Layout: the background is stored planar per row (B row, G row, R row) so that the per-pixel
-/// arithmetic runs in unit-stride, branch-free loops the compiler vectorises; `background_bgr`
-/// gives it interleaved.
+/// Layout: the background and the previous frame are stored planar per row (B row, G row, R
+/// row) so that the per-pixel arithmetic runs in unit-stride, branch-free loops the compiler
+/// vectorises; `background_bgr` gives the background interleaved, `state` the previous frame.
 class BackgroundModel {
 public:
     BackgroundModel(const BackgroundConfig& config, const HsvBinning& binning)
@@ -351,7 +352,7 @@ public:
                 for (int c = 0; c < 3; ++c) {
                     const float v = bgr[(y * cols + x) * 3 + c];
                     background_[static_cast<size_t>((y * 3 + c) * cols + x)] = v;
-                    previous_[static_cast<size_t>((y * cols + x) * 3 + c)] =
+                    previous_[static_cast<size_t>((y * 3 + c) * cols + x)] =
                         static_cast<std::uint8_t>(std::min(std::max(v, 0.0f), 255.0f) + 0.5f);
                 }
     }
@@ -384,21 +385,32 @@ public:
     /// background sum B_b + B_g + B_r is at least `min_sum`, of (I_b + I_g + I_r) / (B_b + B_g +
     /// B_r), in double (numpy.median's value: the mean of the two middle ratios for an even
     /// count). Most pixels are background, so a global illumination change shows as a gain far
-    /// from 1 while people move it little. 1 when no pixel qualifies.
-    double global_gain(const std::uint8_t* bgr, Index row_stride, Index step, double min_sum) {
+    /// from 1 while people move it little. 1 when no pixel qualifies. With `mean`, also
+    /// `sampled_mean` of the frame at `step` into *mean (the same double; the same grid read
+    /// once: the detector asks both of every frame).
+    double global_gain(const std::uint8_t* bgr, Index row_stride, Index step, double min_sum,
+                       double* mean = nullptr) {
         require(initialized(), "BackgroundModel.global_gain", "the model has no background yet");
         require(step >= 1, "BackgroundModel.global_gain", "step", static_cast<double>(step), ">= 1");
         ratios_.clear();
+        std::int64_t levels = 0;  // every sampled pixel's, as sampled_mean sums them
         for (Index y = 0; y < rows_; y += step) {
             const std::uint8_t* px = bgr + y * row_stride;
             const float* q = background_.data() + y * cols_ * 3;
             for (Index x = 0; x < cols_; x += step) {
+                // the sum of three bytes, exact in int and in double: the same ratio as the sum
+                // taken in double
+                const int si = px[3 * x] + px[3 * x + 1] + px[3 * x + 2];
+                levels += si;
                 const double sb = static_cast<double>(q[x]) + static_cast<double>(q[cols_ + x]) +
                                   static_cast<double>(q[2 * cols_ + x]);
                 if (sb < min_sum || sb <= 0.0) continue;
-                const double si = static_cast<double>(px[3 * x]) + px[3 * x + 1] + px[3 * x + 2];
-                ratios_.push_back(si / sb);
+                ratios_.push_back(static_cast<double>(si) / sb);
             }
+        }
+        if (mean != nullptr) {
+            const Index n = ((rows_ - 1) / step + 1) * ((cols_ - 1) / step + 1) * 3;
+            *mean = static_cast<double>(levels) / static_cast<double>(n);
         }
         const size_t n = ratios_.size();
         if (n == 0) return 1.0;
@@ -484,11 +496,12 @@ public:
             float* __restrict qb = background_.data() + y * n3;
             float* __restrict qg = qb + cols;
             float* __restrict qr = qg + cols;
-            std::uint8_t* __restrict prev = previous_.data() + y * n3;
+            std::uint8_t* __restrict prev = previous_.data() + y * n3;  // planar, as qb
             std::int16_t* __restrict o = bins != nullptr ? bins + y * cols : nullptr;
             std::uint8_t* __restrict m = mask + y * cols;
             // (1) deinterleave into float planes, d_prev; I' <- I
-            detail::background_row_split(cols, px, prev, fb, fg, fr, dprev);
+            detail::background_row_split(cols, px, prev, prev + cols, prev + 2 * cols, fb, fg, fr,
+                                         dprev);
             // (3) per pixel, vectorised: table indices (with bins), d_bg, candidates, mask
             if (o != nullptr)
                 detail::background_row_scan(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low, sh, si,
@@ -534,9 +547,12 @@ public:
         std::array<std::int64_t, 256> hist{};
     };
 
+    /// The previous frame goes out interleaved (BGR bytes, as the frame and as the states of
+    /// models before it was kept planar), so that pickles keep their layout.
     State state() const {
-        return State{rows_,     cols_,       frame_count_, learning_, threshold_,
-                     threshold_scale_, background_, previous_,    hist_};
+        return State{rows_,           cols_,       frame_count_,
+                     learning_,       threshold_,  threshold_scale_,
+                     background_,     planar_to_interleaved(previous_, rows_, cols_), hist_};
     }
 
     void restore(State s) {
@@ -557,11 +573,35 @@ public:
         threshold_ = s.threshold;
         threshold_scale_ = s.threshold_scale;
         background_ = std::move(s.background);
-        previous_ = std::move(s.previous);
+        previous_ = interleaved_to_planar(s.previous, rows_, cols_);
         hist_ = s.hist;
     }
 
 private:
+    /// Rows of B, G, R planes (rows x 3 x cols) -> interleaved BGR (rows x cols x 3).
+    static std::vector<std::uint8_t> planar_to_interleaved(const std::vector<std::uint8_t>& p,
+                                                           Index rows, Index cols) {
+        std::vector<std::uint8_t> out(p.size());
+        for (Index y = 0; y < rows; ++y)
+            for (int c = 0; c < 3; ++c)
+                for (Index x = 0; x < cols; ++x)
+                    out[static_cast<size_t>((y * cols + x) * 3 + c)] =
+                        p[static_cast<size_t>((y * 3 + c) * cols + x)];
+        return out;
+    }
+
+    /// Interleaved BGR (rows x cols x 3) -> rows of B, G, R planes (rows x 3 x cols).
+    static std::vector<std::uint8_t> interleaved_to_planar(const std::vector<std::uint8_t>& p,
+                                                           Index rows, Index cols) {
+        std::vector<std::uint8_t> out(p.size());
+        for (Index y = 0; y < rows; ++y)
+            for (int c = 0; c < 3; ++c)
+                for (Index x = 0; x < cols; ++x)
+                    out[static_cast<size_t>((y * 3 + c) * cols + x)] =
+                        p[static_cast<size_t>((y * cols + x) * 3 + c)];
+        return out;
+    }
+
     void allocate(Index rows, Index cols) {
         rows_ = rows;
         cols_ = cols;
@@ -581,7 +621,7 @@ private:
                 for (int c = 0; c < 3; ++c) {
                     background_[static_cast<size_t>((y * 3 + c) * cols + x)] =
                         static_cast<float>(px[3 * x + c]);
-                    previous_[static_cast<size_t>(y * cols * 3 + 3 * x + c)] = px[3 * x + c];
+                    previous_[static_cast<size_t>((y * 3 + c) * cols + x)] = px[3 * x + c];
                 }
                 if (bins != nullptr)
                     bins[y * cols + x] = static_cast<std::int16_t>(
@@ -619,7 +659,7 @@ private:
     double threshold_ = 0.0;
     double threshold_scale_ = 1.0;  // set_threshold_scale
     std::vector<float> background_;      // planar rows: [y][channel][x]
-    std::vector<std::uint8_t> previous_;  // interleaved, as the frame
+    std::vector<std::uint8_t> previous_;  // planar rows, as the background: [y][channel][x]
     std::array<std::int64_t, 256> hist_{};
     std::vector<double> ratios_;  // global_gain's sampled frame / background ratios
     std::vector<float> scratch_f_;  // row scratch: B, G, R planes, d_prev, candidate flag

@@ -45,6 +45,32 @@ struct EdgeScratch {
     std::vector<Index> rx, ry, xm, xp;      // reflected indices
 };
 
+/// `edge_magnitudes`' row pass of the 5x5 Gaussian: tmp (ph x w) from pad (ph x pw, pw = w + 4),
+/// t = g0 p0 + g1 p1 + g2 p2 + g1 p3 + g0 p4 in float32, in this order (no FMA: the AVX2 clone
+/// gives the baseline's floats).
+PFTRACK_VECTOR_CLONES static void blur_rows5(const float* __restrict pad, float* __restrict tmp,
+                                             Index ph, Index w, Index pw, float g0, float g1,
+                                             float g2) {
+    for (Index yy = 0; yy < ph; ++yy) {
+        const float* __restrict p = pad + yy * pw;
+        float* __restrict t = tmp + yy * w;
+        for (Index x = 0; x < w; ++x)
+            t[x] = g0 * p[x] + g1 * p[x + 1] + g2 * p[x + 2] + g1 * p[x + 3] + g0 * p[x + 4];
+    }
+}
+
+/// `edge_magnitudes`' column pass: blur (h x w) from tmp (h + 4 rows of w), the same taps.
+PFTRACK_VECTOR_CLONES static void blur_cols5(const float* __restrict tmp, float* __restrict blur,
+                                             Index h, Index w, float g0, float g1, float g2) {
+    for (Index y = 0; y < h; ++y) {
+        const float* __restrict t0 = tmp + y * w;
+        float* __restrict b = blur + y * w;
+        for (Index x = 0; x < w; ++x)
+            b[x] = g0 * t0[x] + g1 * t0[x + w] + g2 * t0[x + 2 * w] + g1 * t0[x + 3 * w] +
+                   g0 * t0[x + 4 * w];
+    }
+}
+
 /// The edge magnitude at each band pixel (`band`, h x w, row-major, non-zero = in), in row-major
 /// order, into `mag`: sqrt(max_c (gx_c^2 + gy_c^2)), gx, gy the 3x3 Sobel derivatives of the 5x5
 /// Gaussian blur (float32, as OpenCV's) of channel c of the h x w image whose row y of channel c
@@ -79,19 +105,9 @@ void edge_magnitudes(FillRow fill_row, Index h, Index w, const std::vector<std::
                 row[xx] = row[2 + s.rx[static_cast<size_t>(xx)]];
         }
         // rows first, then columns (OpenCV's separable order)
-        for (Index yy = 0; yy < ph; ++yy) {
-            const float* __restrict p = s.pad.data() + yy * pw;
-            float* __restrict t = s.tmp.data() + yy * w;
-            for (Index x = 0; x < w; ++x)
-                t[x] = g0 * p[x] + g1 * p[x + 1] + g2 * p[x + 2] + g1 * p[x + 3] + g0 * p[x + 4];
-        }
-        for (Index y = 0; y < h; ++y) {
-            const float* __restrict t0 = s.tmp.data() + y * w;
-            float* __restrict b = s.blur.data() + (c * h + y) * w;
-            for (Index x = 0; x < w; ++x)
-                b[x] = g0 * t0[x] + g1 * t0[x + w] + g2 * t0[x + 2 * w] + g1 * t0[x + 3 * w] +
-                       g0 * t0[x + 4 * w];
-        }
+        // (AVX2 or baseline clones: blur_rows5, blur_cols5)
+        blur_rows5(s.pad.data(), s.tmp.data(), ph, w, pw, g0, g1, g2);
+        blur_cols5(s.tmp.data(), s.blur.data() + c * h * w, h, w, g0, g1, g2);
     }
     mag.clear();
     for (Index y = 0; y < h; ++y) {

@@ -41,6 +41,8 @@ STILL_FRAMES = 50
 #: Frames an object may go unmatched (merged with a passer-by, a frame where its blob broke)
 #: before it is forgotten; its last box stays held meanwhile.
 HOLD_MISSES = 25
+#: `StopMemory._stand_at` when no object has walked: no frame reaches it.
+_NEVER = 2**62
 
 
 class StopMemory:
@@ -51,6 +53,11 @@ class StopMemory:
     hold_frames : int
         Frames after an object last moved during which its box is held (0: nothing is held).
     """
+
+    #: the first frame at which an object that walked can have stood `STILL_FRAMES` (`observe`
+    #: sets it; before it, `held` and `still` are empty without a test per object: most frames
+    #: of a video of walkers). 0, as in a memory pickled before it was kept: test every time.
+    _stand_at = 0
 
     def __init__(self, hold_frames: int) -> None:
         self.hold_frames = hold_frames
@@ -65,10 +72,13 @@ class StopMemory:
         self._walked = np.zeros(0, bool)  # whether it ever moved
         self._missed = np.zeros(0, np.int64)  # frames since last matched
         self._own: F64 = np.zeros((0, 4))  # its own size's last box (where it stands)
+        self._stand_at = _NEVER  # nobody walked
 
     @property
     def held(self) -> F64:
         """(K, 4) ``left, top, width, height`` of the boxes held now."""
+        if self._frame < self._stand_at:
+            return self._boxes[:0]
         still = self._frame - self._since
         keep = self._walked & (still >= STILL_FRAMES) & (still <= self.hold_frames)
         out: F64 = self._boxes[keep]
@@ -77,6 +87,8 @@ class StopMemory:
     @property
     def still(self) -> F64:
         """(K, 4) boxes of the objects seen this frame that have not moved for `STILL_FRAMES`."""
+        if self._frame < self._stand_at:
+            return self._boxes[:0]
         keep = self._walked & (self._missed == 0) & (self._frame - self._since >= STILL_FRAMES)
         out: F64 = self._boxes[keep]
         return out
@@ -147,6 +159,9 @@ class StopMemory:
         self._walked = np.concatenate([walked, self._walked[~taken][kept]])
         self._missed = np.concatenate([np.zeros(k, np.int64), missed[kept]])
         self._own = np.vstack([own, self._own[~taken][kept]])
+        # frame - since >= STILL_FRAMES for an object that walked from this frame on, not before
+        walked_since = self._since[self._walked]
+        self._stand_at = int(walked_since.min()) + STILL_FRAMES if len(walked_since) else _NEVER
 
     def hold_mask(self, shape: tuple[int, int]) -> NDArray[np.uint8] | None:
         """(H, W) uint8 mask of the held boxes (1 inside), or None when none is held."""

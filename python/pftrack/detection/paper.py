@@ -372,13 +372,21 @@ class PaperDetector:
             )
         self._seen += 1
         step = sample_step(frame.shape, GAIN_SAMPLE_STEP)
-        if self.config.gain_band > 0 and is_dark(frame, step):
-            return self._unlit(frame, bins)  # no light to compare or learn (light.is_dark)
+        gain = 1.0
+        if self.config.gain_band > 0:
+            # is_dark(frame, step)'s test without its checks (the frame is checked, the step is
+            # sample_step's), with the global gain of a model that has a background: one read
+            # of the sampled pixels for both (mean_and_gain's mean is sampled_mean's double)
+            if self._model.initialized:
+                mean, gain = self._model.mean_and_gain(frame, step)
+            else:
+                mean = _core.sampled_mean(frame, step)
+            if mean <= DARK_LEVEL:
+                return self._unlit(frame, bins)  # no light to compare or learn (light.is_dark)
         if not self._model.initialized:
             if self._grey is None:
                 self._decide_grey([frame])
         elif self.config.gain_band > 0:
-            gain = self._model.global_gain(frame, step)
             if gain <= 0.0:  # over half the sampled pixels black (not dark as a whole)
                 return self._unlit(frame, bins)
             if abs(gain - 1.0) > self.config.gain_band:
