@@ -47,6 +47,18 @@ def frame_truth(src: Source, data: Path) -> F64:
     return gt
 
 
+def scene_size(
+    count_name: str, count: int, n_frames: int, size: tuple[int, int]
+) -> tuple[int, int]:
+    """A synthetic scene's ``size`` (width, height), its object count and length checked."""
+    if count < 1 or n_frames < 1:
+        raise ValueError(f"{count_name} {count} and n_frames {n_frames} must be >= 1")
+    width, height = size
+    if width < 160 or height < 120:
+        raise ValueError(f"size is {size}, expected at least 160 x 120")
+    return width, height
+
+
 def data_root(arg: PathLike | None = None) -> Path:
     """The folder holding ``pets09-s2l1/`` and ``tud-campus/``.
 

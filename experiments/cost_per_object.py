@@ -40,7 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import pftrack
-from experiments._common import experiment_parser, tee_stdout, write_text
+from experiments._common import experiment_parser, scene_size, tee_stdout, write_text
 from pftrack._typing import F64
 from pftrack.io.opencv_io import write_image
 from pftrack.tracking import tracker as tracker_module
@@ -76,11 +76,7 @@ def make_crowd(
     detections : list of (N, 5) float64
         Per frame, the walkers' boxes ``x1, y1, x2, y2, 1.0``.
     """
-    if n_objects < 1 or n_frames < 1:
-        raise ValueError(f"n_objects {n_objects} and n_frames {n_frames} must be >= 1")
-    width, height = size
-    if width < 160 or height < 120:
-        raise ValueError(f"size is {size}, expected at least 160 x 120")
+    width, height = scene_size("n_objects", n_objects, n_frames, size)
     rng = np.random.default_rng(seed)
     small = rng.integers(70, 150, (height // 24 + 1, width // 24 + 1, 3)).astype(np.uint8)
     background = cv2.resize(small, (width, height), interpolation=cv2.INTER_CUBIC)

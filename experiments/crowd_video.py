@@ -34,7 +34,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from experiments._common import experiment_parser
+from experiments._common import experiment_parser, scene_size
 from pftrack._typing import F64
 from pftrack.io.atomic import atomic_path
 from pftrack.io.mot import write_mot
@@ -112,11 +112,7 @@ def crowd_frames(
 
     `n_walkers` people are in view on every frame; see the module's description.
     """
-    if n_walkers < 1 or n_frames < 1:
-        raise ValueError(f"n_walkers {n_walkers} and n_frames {n_frames} must be >= 1")
-    width, height = size
-    if width < 160 or height < 120:
-        raise ValueError(f"size is {size}, expected at least 160 x 120")
+    width, height = scene_size("n_walkers", n_walkers, n_frames, size)
     gen = np.random.default_rng(seed)
     bg = _background(width, height, gen)
     people = [_new_person(k + 1, gen, width, height, inside=True) for k in range(n_walkers)]

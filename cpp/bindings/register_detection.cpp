@@ -31,6 +31,16 @@ py::array_t<std::uint8_t> new_mask(Index rows, Index cols) {
     return py::array_t<std::uint8_t>({static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(cols)});
 }
 
+/// The frame (H, W, 3) uint8 of the size of the model's (initialised) background.
+py::array model_frame(const BackgroundModel& self, const py::object& frame_in, const char* fn) {
+    py::array frame = bind::bgr_image(frame_in, fn, "frame");
+    require(self.initialized(), fn, "the model has no background yet");
+    require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
+            "frame shape is " + shape_str(frame) + ", expected (" + std::to_string(self.rows()) +
+                ", " + std::to_string(self.cols()) + ", 3)");
+    return frame;
+}
+
 /// A frame and a mask of the size of the model's (initialised) background.
 void check_frame_and_mask(const BackgroundModel& self, const py::array& frame,
                           const py::array& mask, const char* fn) {
@@ -162,12 +172,7 @@ void register_detection(py::module_& m) {
             [](BackgroundModel& self, const py::object& frame_in, Index step, double min_sum) {
                 const char* fn = "BackgroundModel.global_gain";
                 const bind::InUse busy(&self, fn);
-                const py::array frame = bind::bgr_image(frame_in, fn, "frame");
-                require(self.initialized(), fn, "the model has no background yet");
-                require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
-                        "frame shape is " + shape_str(frame) + ", expected (" +
-                            std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
-                            ", 3)");
+                const py::array frame = model_frame(self, frame_in, fn);
                 const auto* src = static_cast<const std::uint8_t*>(frame.data());
                 const Index stride = frame.strides(0);
                 py::gil_scoped_release nogil;  // safe: raw buffer held by the caller
@@ -181,12 +186,7 @@ void register_detection(py::module_& m) {
             [](BackgroundModel& self, const py::object& frame_in, Index step, double min_sum) {
                 const char* fn = "BackgroundModel.mean_and_gain";
                 const bind::InUse busy(&self, fn);
-                const py::array frame = bind::bgr_image(frame_in, fn, "frame");
-                require(self.initialized(), fn, "the model has no background yet");
-                require(frame.shape(0) == self.rows() && frame.shape(1) == self.cols(), fn,
-                        "frame shape is " + shape_str(frame) + ", expected (" +
-                            std::to_string(self.rows()) + ", " + std::to_string(self.cols()) +
-                            ", 3)");
+                const py::array frame = model_frame(self, frame_in, fn);
                 require(step >= 1, fn, "step", static_cast<double>(step), ">= 1");
                 const auto* src = static_cast<const std::uint8_t*>(frame.data());
                 const Index stride = frame.strides(0);
