@@ -19,6 +19,11 @@ namespace py = pybind11;
 
 inline std::string dtype_name(const py::array& a) { return py::str(a.dtype()).cast<std::string>(); }
 
+/// The name of `obj`'s type ("list", "NoneType", "ndarray"), for one-line TypeErrors.
+inline std::string type_name(const py::handle& obj) {
+    return py::str(py::type::of(obj).attr("__name__")).cast<std::string>();
+}
+
 /// Whether dtype `d` is T's: the same descriptor object (the usual case, no call), or an
 /// equivalent one (PyArray_EquivTypes: an array that went through pickle has an equal but
 /// distinct descriptor; a byte-swapped one is not equivalent).
@@ -58,7 +63,7 @@ inline py::array ndarray(const py::handle& obj, const char* fn, const char* what
                          const std::string& expected) {
     if (!py::isinstance<py::array>(obj))
         throw py::type_error(std::string(fn) + ": " + what + " is " +
-                             py::str(py::type::of(obj).attr("__name__")).cast<std::string>() +
+                             type_name(obj) +
                              ", expected a numpy.ndarray " + expected);
     return py::reinterpret_borrow<py::array>(obj);
 }
@@ -112,7 +117,7 @@ inline py::array inplace_f64(const py::handle& obj, const char* fn, const char* 
                              "copied)";
     if (!py::isinstance<py::array>(obj))
         throw py::type_error(std::string(fn) + ": " + what + " must be " + want + ", got " +
-                             py::str(py::type::of(obj).attr("__name__")).cast<std::string>());
+                             type_name(obj));
     const auto a = py::reinterpret_borrow<py::array>(obj);
     if (!is_dtype<double>(a.dtype())) {
         const bool swapped = a.dtype().kind() == 'f' && a.dtype().itemsize() == 8;

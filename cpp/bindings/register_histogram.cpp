@@ -61,14 +61,14 @@ void register_histogram(py::module_& m) {
                  // conversion to int, whose refusal of 2**31 lists every signature instead
                  if (py::isinstance<py::bool_>(n_in) || !PyIndex_Check(n_in.ptr()))
                      throw py::type_error(std::string(fn) + ": n_bins must be an int, got " +
-                                          py::str(py::type::of(n_in).attr("__name__")).cast<std::string>());
+                                          bind::type_name(n_in));
                  const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(n_in.ptr()));
                  if (!index) {  // an array of floats, or of several values: was NumPy's "only
                      PyErr_Clear();  // integer scalar arrays can be converted ...", no name
                      const py::array a = py::array::ensure(n_in);
                      throw py::type_error(
                          std::string(fn) + ": n_bins must be an int, got " +
-                         py::str(py::type::of(n_in).attr("__name__")).cast<std::string>() +
+                         bind::type_name(n_in) +
                          (a ? " of " + bind::dtype_name(a) : ""));
                  }
                  int overflow = 0;
@@ -83,7 +83,7 @@ void register_histogram(py::module_& m) {
                  if (!given)
                      throw py::value_error(std::string(fn) + ": bins must be an (H, W) array of "
                                            "bin indices, got a " +
-                                           py::str(py::type::of(bins_in).attr("__name__")).cast<std::string>() +
+                                           bind::type_name(bins_in) +
                                            " NumPy cannot make one of");
                  const char kind = given.dtype().kind();
                  if (kind != 'b' && kind != 'i' && kind != 'u' && kind != 'f')

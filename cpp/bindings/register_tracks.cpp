@@ -51,7 +51,7 @@ std::string item(const char* what, size_t k, const char* name) {
 void read_pair(const py::handle& obj, const char* fn, const std::string& what, double* out) {
     if (!py::isinstance<py::array>(obj))
         throw py::type_error(std::string(fn) + ": " + what + " is " +
-                             py::str(py::type::of(obj).attr("__name__")).cast<std::string>() +
+                             bind::type_name(obj) +
                              ", expected a (2,) float64 array");
     auto a = py::reinterpret_borrow<py::array>(obj);
     if (!bind::is_dtype<double>(a.dtype())) {
@@ -74,7 +74,7 @@ double number(const py::handle& obj, const char* fn, const std::string& what) {
     if (x == -1.0 && PyErr_Occurred()) {
         PyErr_Clear();
         throw py::type_error(std::string(fn) + ": " + what + " is " +
-                             py::str(py::type::of(obj).attr("__name__")).cast<std::string>() +
+                             bind::type_name(obj) +
                              ", expected a float");
     }
     return x;
@@ -86,8 +86,6 @@ struct Read {
     CentreState s;
     double w, h;
 };
-
-
 
 Read read_track(const py::handle& t, const char* fn, size_t k) {
     const Names& n = names();
@@ -143,7 +141,7 @@ void require_finite_state(const char* fn, size_t k, const double* row, int cols,
 py::list track_list(const py::handle& tracks, const char* fn) {
     if (!PyList_Check(tracks.ptr()))
         throw py::type_error(std::string(fn) + ": tracks is " +
-                             py::str(py::type::of(tracks).attr("__name__")).cast<std::string>() +
+                             bind::type_name(tracks) +
                              ", expected a list of LiveTrack");
     return py::reinterpret_borrow<py::list>(tracks);
 }
@@ -179,7 +177,7 @@ void register_tracks(py::module_& m) {
             if (!(PyList_Check(gains_in.ptr()) || PyTuple_Check(gains_in.ptr())))
                 throw py::type_error(
                     std::string(fn) + ": gains is " +
-                    py::str(py::type::of(gains_in).attr("__name__")).cast<std::string>() +
+                    bind::type_name(gains_in) +
                     ", expected a list of floats, one per track");
             const auto gain_seq = py::reinterpret_borrow<py::sequence>(gains_in);
             if (gain_seq.size() != k)
