@@ -325,11 +325,7 @@ public:
 
     /// The background, interleaved BGR, into `out` (rows x cols x 3 floats).
     void background_bgr(float* out) const {
-        for (Index y = 0; y < rows_; ++y)
-            for (int c = 0; c < 3; ++c) {
-                const float* plane = background_.data() + (y * 3 + c) * cols_;
-                for (Index x = 0; x < cols_; ++x) out[(y * cols_ + x) * 3 + c] = plane[x];
-            }
+        relayout(background_.data(), out, rows_, cols_, false);
     }
 
     void reset() {
@@ -552,7 +548,7 @@ public:
     State state() const {
         return State{rows_,           cols_,       frame_count_,
                      learning_,       threshold_,  threshold_scale_,
-                     background_,     planar_to_interleaved(previous_, rows_, cols_), hist_};
+                     background_,     relaid(previous_, rows_, cols_, false), hist_};
     }
 
     void restore(State s) {
@@ -573,32 +569,31 @@ public:
         threshold_ = s.threshold;
         threshold_scale_ = s.threshold_scale;
         background_ = std::move(s.background);
-        previous_ = interleaved_to_planar(s.previous, rows_, cols_);
+        previous_ = relaid(s.previous, rows_, cols_, true);
         hist_ = s.hist;
     }
 
 private:
-    /// Rows of B, G, R planes (rows x 3 x cols) -> interleaved BGR (rows x cols x 3).
-    static std::vector<std::uint8_t> planar_to_interleaved(const std::vector<std::uint8_t>& p,
-                                                           Index rows, Index cols) {
-        std::vector<std::uint8_t> out(p.size());
+    /// Rows of B, G, R planes (rows x 3 x cols: channel c of pixel (y, x) at
+    /// [(y * 3 + c) * cols + x]) into interleaved BGR (rows x cols x 3) at `out`, or back
+    /// when `to_planar`. Not a per-frame path: pickling, and the background for Python.
+    template <class T>
+    static void relayout(const T* in, T* out, Index rows, Index cols, bool to_planar) {
         for (Index y = 0; y < rows; ++y)
             for (int c = 0; c < 3; ++c)
-                for (Index x = 0; x < cols; ++x)
-                    out[static_cast<size_t>((y * cols + x) * 3 + c)] =
-                        p[static_cast<size_t>((y * 3 + c) * cols + x)];
-        return out;
+                for (Index x = 0; x < cols; ++x) {
+                    const Index planar = (y * 3 + c) * cols + x, bgr = (y * cols + x) * 3 + c;
+                    if (to_planar)
+                        out[planar] = in[bgr];
+                    else
+                        out[bgr] = in[planar];
+                }
     }
 
-    /// Interleaved BGR (rows x cols x 3) -> rows of B, G, R planes (rows x 3 x cols).
-    static std::vector<std::uint8_t> interleaved_to_planar(const std::vector<std::uint8_t>& p,
-                                                           Index rows, Index cols) {
-        std::vector<std::uint8_t> out(p.size());
-        for (Index y = 0; y < rows; ++y)
-            for (int c = 0; c < 3; ++c)
-                for (Index x = 0; x < cols; ++x)
-                    out[static_cast<size_t>((y * 3 + c) * cols + x)] =
-                        p[static_cast<size_t>((y * cols + x) * 3 + c)];
+    static std::vector<std::uint8_t> relaid(const std::vector<std::uint8_t>& in, Index rows,
+                                            Index cols, bool to_planar) {
+        std::vector<std::uint8_t> out(in.size());
+        relayout(in.data(), out.data(), rows, cols, to_planar);
         return out;
     }
 
