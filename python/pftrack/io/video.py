@@ -986,6 +986,19 @@ def _resume(
     return None
 
 
+def _resume_grab(
+    cap: cv2.VideoCapture, rate: float, start: int, at: int, n_frames: int
+) -> int | None:
+    """:func:`_resume` for a pass of grabs: the index of the next frame that decodes, or None."""
+    if rate <= 0 or at >= n_frames:
+        return None
+    for _ in range(RESUME_TRIES):
+        if cap.grab():
+            index = _stamp_index(cap, rate) - start
+            return index if at <= index < n_frames else None
+    return None
+
+
 class _DamagedInside(Exception):  # a signal between readers, never raised out of them
     """A pass of grabs stopped at a frame that fails to decode, with frames after it that do.
 
@@ -2325,9 +2338,28 @@ class FrameSource:
         cap = _file_capture(str(self.path))
         found = 0
         last_ms: float | None = None  # the last frame's time stamp
+        rate = float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
+        timed = rate > 0  # as _iter_stored: the stamps give the frames' indexes, so far
+        start = 0  # the first frame's stamp, in frames
         try:
-            while cap.grab():
-                found += 1
+            while True:
+                if cap.grab():
+                    if timed:
+                        stamp = _stamp_index(cap, rate)
+                        if found == 0:
+                            start = stamp
+                        elif stamp - start != found:
+                            timed = False  # not a constant-rate file: no resuming
+                    found += 1
+                    last_ms = float(cap.get(cv2.CAP_PROP_POS_MSEC))
+                    continue
+                # a frame inside that fails to decode: reading goes on past it, with the
+                # frame before standing in (_iter_stored), so the count does too (was: the
+                # frames before it taken as the video's, a run cut there, "it holds 14")
+                at = _resume_grab(cap, rate, start, found, self.n_frames) if timed else None
+                if at is None:
+                    break
+                found = at + 1
                 last_ms = float(cap.get(cv2.CAP_PROP_POS_MSEC))
         finally:
             cap.release()
