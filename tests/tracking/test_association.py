@@ -73,10 +73,10 @@ def _one_thread_products(
 
 
 def test_the_colour_product_of_a_crowd_has_one_blas_threads_bits(tmp_path: Path) -> None:
-    # was `sqrt(references) @ sqrt(hists).T` on OpenBLAS's pool from about 70 x 70: 0.2-0.4 ms
-    # of CPU a product at 100 x 100 against 0.1, and sums that differ from one thread's (what
-    # `pftrack track` runs) in their last bits, so a library tracker of 70+ tracks gave other
-    # rows than the command, and than itself on a machine of another core count
+    # was `sqrt(references) @ sqrt(hists).T` on OpenBLAS's pool from about 70 x 70: 0.24-2.6 ms
+    # of CPU a product at 100 x 100 against 0.06-0.09, and sums that differ from one thread's (what
+    # `pftrack track` runs) in their last bits, so a library tracker of 70+ tracks weighed its
+    # pairs otherwise than the command, and than itself on a machine of another core count
     get, put = _blas_or_skip()
     rng = np.random.default_rng(3)
     shapes = [(75, 75), (70, 71), (100, 100), (100, 102), (150, 151), (49, 50), (24, 30)]

@@ -136,17 +136,17 @@ def colour_product(a: F64, b: F64) -> F64:
 
     The association's colour product, ``sqrt(references) @ sqrt(hists).T``, (T, B) by (B, D),
     goes to OpenBLAS's ``dgemm``, which from about 70 x 70 (B = 110) splits it over its thread
-    pool: 0.2-0.4 ms of CPU for a 100 x 100 product against 0.1 on one thread, and the pool's
-    threads spin on the cores the tracker needs (crowd65: 1.8-2.7 ms at load 15-19). The
-    split's sums also differ from one thread's in their last bits (0.4e-13 on 10 of 18 shapes
-    from 70 x 70 on), so a library tracker of 70+ tracks gave other rows than ``pftrack
-    track`` (one BLAS thread, :func:`pftrack._threads.one_blas_thread`), and other rows on a
+    pool: 0.24-2.6 ms of CPU for a 100 x 100 product against 0.06-0.09 ms on one thread (at
+    load 10-20; the pool's threads spin on the cores the tracker needs). The split's sums also
+    differ from one thread's in their last bits (10 of 18 shapes from 70 x 70 on), so a
+    library tracker of 70+ tracks weighed its pairs otherwise than ``pftrack track`` (one BLAS
+    thread from its start, :func:`pftrack._threads.one_blas_thread`) and than itself on a
     machine of another core count. Above :data:`ONE_THREAD_PRODUCT` multiply-adds, with
-    NumPy's BLAS an OpenBLAS whose count is above 1, the count is set to 1 for the product
-    and set back after it (under a lock): the product is then one thread's, the same bits as
-    ``pftrack track``'s. The count is the process's: a BLAS call of another thread that falls
-    inside those microseconds runs on one thread too. Any other BLAS (MKL, Accelerate): the
-    plain product.
+    NumPy's BLAS the OpenBLAS of NumPy's wheels at more than one thread, the count is set to
+    1 for the product and set back after it (under a lock): the product is one thread's, the
+    same bits as ``pftrack track``'s (tests/tracking/test_association.py). The count is the
+    process's: a BLAS call of another thread that falls inside those microseconds runs on one
+    thread too. Any other BLAS (MKL, Accelerate, a system OpenBLAS): the plain product.
     """
     if a.shape[0] * a.shape[1] * b.shape[1] <= ONE_THREAD_PRODUCT:
         out: F64 = a @ b
