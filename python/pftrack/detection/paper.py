@@ -534,7 +534,7 @@ class PaperDetector:
         if self.config.ghost_support > 0 and self._ghost is not None:
             # a ghost found earlier: its pixels still foreground keep being learnt fast
             carry = np.bitwise_and(mask, self._ghost)
-            if carry.any():
+            if cv2.countNonZero(carry):  # carry.any() in a third of its instructions
                 self._model.blend(frame, carry, self.config.ghost_rate)
                 mask = np.bitwise_xor(mask, carry)
                 self._ghost = carry
