@@ -160,3 +160,31 @@ def test_edge_support_statistic_is_checked() -> None:
         model_with(background).edge_support(frame, mask, boxes, "median")
     with pytest.raises(ValueError, match="statistic is 'median'"):
         edge_support(frame, background, mask, boxes, "median")
+
+
+@pytest.mark.parametrize("statistic", ["ratio", "vote"])
+def test_edge_support_at_every_region_size(statistic: str) -> None:
+    """Regions 3 to 42 px wide and tall, inside the frame and clipped at each of its sides: the
+    band's and the blur's row loops (vectorised, with their ends) against the reference."""
+    rng = np.random.default_rng(21)
+    rows, cols = 70, 90
+    frame = (rng.integers(0, 256, (rows, cols, 3), dtype=np.uint8) // 32 * 32).astype(np.uint8)
+    background = rng.uniform(0, 255, (rows, cols, 3)).astype(np.float32)
+    mask = np.where(rng.random((rows, cols)) < 0.7, 255, 0).astype(np.uint8)
+    mask[20:50, 30:60] = 255  # a solid blob: a band only about its outline
+    sizes = range(3, 43, 3)
+    boxes = np.array(
+        [[14, 16, s - 8, s - 8] for s in sizes]  # region [10, 10 + s) x [12, 12 + s)
+        + [[-2, -2, s - 2, s - 2] for s in sizes]  # clipped at the near sides: [0, s)
+        + [[cols - s + 4, rows - s + 4, s, s] for s in sizes]  # at the far sides
+        + [[26, 16, 38, 38]],  # the solid blob's box
+        np.float64,
+    )
+    got = model_with(background).edge_support(frame, mask, boxes, statistic)
+    want = edge_support_reference(frame, background, mask, boxes, statistic)
+    if statistic == "ratio":
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-5)
+    else:  # float32 against float64 magnitudes: a near tie may go either way
+        np.testing.assert_allclose(got, want, rtol=0, atol=0.05)
+        assert np.mean(got == want) > 0.9
+    assert not np.any(got == 0.5)  # every region has a band

@@ -132,6 +132,56 @@ void edge_magnitudes(FillRow fill_row, Index h, Index w, const std::vector<std::
     }
 }
 
+/// `edge_support`'s boundary band of an h x w region (h, w >= 3) of a mask (row y at
+/// mask + y * mask_stride): band = (3x3 dilation of mask != 0) and not (3x3 erosion of it), as
+/// 0/1, both taken inside the region only (outside neighbours do not count), as row maxima /
+/// minima of the 0/1 mask (`on`, `hmax`, `hmin`: h x w scratch), then column ones. Whether any
+/// pixel is in the band.
+PFTRACK_VECTOR_CLONES static bool band_rows(const std::uint8_t* mask, Index mask_stride,
+                                            Index h, Index w, std::uint8_t* __restrict on,
+                                            std::uint8_t* __restrict hmax,
+                                            std::uint8_t* __restrict hmin,
+                                            std::uint8_t* __restrict band) {
+    for (Index y = 0; y < h; ++y) {
+        const std::uint8_t* __restrict m = mask + y * mask_stride;
+        std::uint8_t* __restrict o = on + y * w;
+        for (Index x = 0; x < w; ++x) o[x] = m[x] != 0 ? 1 : 0;
+        std::uint8_t* __restrict mx = hmax + y * w;
+        std::uint8_t* __restrict mn = hmin + y * w;
+        mx[0] = std::max(o[0], o[1]);
+        mn[0] = std::min(o[0], o[1]);
+        for (Index x = 1; x < w - 1; ++x) {  // of 0/1: max is or, min is and
+            mx[x] = static_cast<std::uint8_t>(o[x - 1] | o[x] | o[x + 1]);
+            mn[x] = static_cast<std::uint8_t>(o[x - 1] & o[x] & o[x + 1]);
+        }
+        mx[w - 1] = std::max(o[w - 2], o[w - 1]);
+        mn[w - 1] = std::min(o[w - 2], o[w - 1]);
+    }
+    std::uint8_t any = 0;
+    for (Index y = 0; y < h; ++y) {
+        const Index a = std::max(y - 1, Index(0)), z = std::min(y + 1, h - 1);
+        const std::uint8_t* __restrict xa = hmax + a * w;
+        const std::uint8_t* __restrict xy = hmax + y * w;
+        const std::uint8_t* __restrict xz = hmax + z * w;
+        const std::uint8_t* __restrict na = hmin + a * w;
+        const std::uint8_t* __restrict ny = hmin + y * w;
+        const std::uint8_t* __restrict nz = hmin + z * w;
+        std::uint8_t* __restrict bd = band + y * w;
+        for (Index x = 0; x < w; ++x) {
+            const int dil = xa[x] | xy[x] | xz[x], ero = na[x] & ny[x] & nz[x];
+            bd[x] = static_cast<std::uint8_t>(dil & (ero ^ 1));
+            any |= bd[x];
+        }
+    }
+    return any != 0;
+}
+
+/// Channel c's bytes of n interleaved BGR pixels as floats: out[x] = p[3 x] (p at channel c).
+PFTRACK_VECTOR_CLONES static void channel_floats(const std::uint8_t* __restrict p,
+                                                 float* __restrict out, Index n) {
+    for (Index x = 0; x < n; ++x) out[x] = static_cast<float>(p[3 * x]);
+}
+
 }  // namespace detail
 
 /// The ghost test's statistic over a blob's boundary band.
@@ -172,50 +222,18 @@ inline void edge_support(const std::uint8_t* bgr, Index row_stride, const float*
         if (x1 - x0 < 3 || y1 - y0 < 3) continue;
         const Index w = x1 - x0, h = y1 - y0;
         const auto n = static_cast<size_t>(w * h);
-        // 3x3 dilation and erosion inside the region (outside neighbours do not count), as
-        // row maxima / minima of the 0/1 mask, then column ones (w, h >= 3 here); plain loops
-        // over whole rows, which the compiler vectorises
+        band.resize(n);
         on.resize(n);
         hmax.resize(n);
         hmin.resize(n);
-        band.resize(n);
-        for (Index y = 0; y < h; ++y) {
-            const std::uint8_t* __restrict m = mask + (y0 + y) * mask_stride + x0;
-            std::uint8_t* __restrict o = on.data() + y * w;
-            for (Index x = 0; x < w; ++x) o[x] = m[x] != 0 ? 1 : 0;
-            std::uint8_t* __restrict mx = hmax.data() + y * w;
-            std::uint8_t* __restrict mn = hmin.data() + y * w;
-            mx[0] = std::max(o[0], o[1]);
-            mn[0] = std::min(o[0], o[1]);
-            for (Index x = 1; x + 1 < w; ++x) {
-                mx[x] = std::max(std::max(o[x - 1], o[x]), o[x + 1]);
-                mn[x] = std::min(std::min(o[x - 1], o[x]), o[x + 1]);
-            }
-            mx[w - 1] = std::max(o[w - 2], o[w - 1]);
-            mn[w - 1] = std::min(o[w - 2], o[w - 1]);
-        }
-        std::uint8_t any = 0;
-        for (Index y = 0; y < h; ++y) {
-            const Index a = std::max(y - 1, Index(0)), z = std::min(y + 1, h - 1);
-            const std::uint8_t* __restrict xa = hmax.data() + a * w;
-            const std::uint8_t* __restrict xy = hmax.data() + y * w;
-            const std::uint8_t* __restrict xz = hmax.data() + z * w;
-            const std::uint8_t* __restrict na = hmin.data() + a * w;
-            const std::uint8_t* __restrict ny = hmin.data() + y * w;
-            const std::uint8_t* __restrict nz = hmin.data() + z * w;
-            std::uint8_t* __restrict bd = band.data() + y * w;
-            for (Index x = 0; x < w; ++x) {
-                const std::uint8_t dil = std::max(std::max(xa[x], xy[x]), xz[x]);
-                const std::uint8_t ero = std::min(std::min(na[x], ny[x]), nz[x]);
-                bd[x] = static_cast<std::uint8_t>(dil & (ero ^ 1));
-                any |= bd[x];
-            }
-        }
-        if (!any) continue;
+        // (AVX2 or baseline clones: detail::band_rows)
+        if (!detail::band_rows(mask + y0 * mask_stride + x0, mask_stride, h, w, on.data(),
+                               hmax.data(), hmin.data(), band.data()))
+            continue;
         detail::edge_magnitudes(
             [&](Index y, int c, float* __restrict out) {
-                const std::uint8_t* __restrict p = bgr + (y0 + y) * row_stride + 3 * x0 + c;
-                for (Index x = 0; x < w; ++x) out[x] = static_cast<float>(p[3 * x]);
+                // (AVX2 or baseline clones: detail::channel_floats)
+                detail::channel_floats(bgr + (y0 + y) * row_stride + 3 * x0 + c, out, w);
             },
             h, w, band, scratch, mag_f);
         detail::edge_magnitudes(

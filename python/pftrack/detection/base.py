@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import cv2
 import numpy as np
@@ -188,6 +188,17 @@ class BlobConfig:
         o = self.open_size if self.open_size is not None else max(3, round(rows / 120)) | 1
         c = self.close_size if self.close_size is not None else max(3, round(rows / 72)) | 1
         return int(o), int(c)
+
+
+def _count_nonzero(mask: NDArray[Any]) -> int:
+    """``np.count_nonzero(mask)``, the same count.
+
+    Of a C-contiguous (H, W) uint8 mask by OpenCV: a third of NumPy's instructions at 480x360
+    (callgrind, 0.045 against 0.145 M a call).
+    """
+    if mask.dtype == np.uint8 and mask.ndim == 2 and mask.flags.c_contiguous:
+        return int(cv2.countNonZero(mask))
+    return int(np.count_nonzero(mask))
 
 
 def check_frame(frame: object, fn: str) -> NDArray[np.uint8]:
@@ -429,7 +440,7 @@ class BlobExtractor:
         prev, prev_moved, prev_walked = self._large, self._large_moved, self._large_walked
         self._large, self._large_moved = np.zeros((0, 4)), np.zeros(0, dtype=bool)
         self._large_walked = np.zeros(0, dtype=bool)
-        if cfg.max_area >= 1.0 or np.count_nonzero(mask) <= cfg.max_area * mask.size:
+        if cfg.max_area >= 1.0 or _count_nonzero(mask) <= cfg.max_area * mask.size:
             return self._large, np.zeros(0)
         sc = self.size_model.config
         rects, fill = _core.blob_boxes(

@@ -534,7 +534,7 @@ class PaperDetector:
         if self.config.ghost_support > 0 and self._ghost is not None:
             # a ghost found earlier: its pixels still foreground keep being learnt fast
             carry = np.bitwise_and(mask, self._ghost)
-            if carry.any():
+            if cv2.countNonZero(carry):  # carry.any() in a third of its instructions
                 self._model.blend(frame, carry, self.config.ghost_rate)
                 mask = np.bitwise_xor(mask, carry)
                 self._ghost = carry
@@ -552,7 +552,11 @@ class PaperDetector:
             # after the size model observed the blobs' own boxes (it never learns from these);
             # no box grows into a ghost (this frame's ghost pixels are background being learnt)
             if self._ghost is not None:  # in place: `shaded` is this frame's own array
-                shaded[self._ghost != 0] = 0
+                # shaded[ghost != 0] = 0 by OpenCV: 255 where the ghost is 0, then and (under a
+                # third of the boolean index's instructions: callgrind, 0.15 against 0.50 M at
+                # 480x360)
+                keep = cv2.threshold(self._ghost, 0, 255, cv2.THRESH_BINARY_INV)[1]
+                cv2.bitwise_and(shaded, keep, dst=shaded)
             boxes = size.extend_legs(shaded, boxes, self.config.leg_height, self.config.leg_fill)
         stops.observe(boxes)  # the boxes whose pixels the next frame holds
         # the colours of the kept foreground only (the full frame's bins, which only a moving
