@@ -350,8 +350,9 @@ def track_frames(
                 # one decode where they fit: the frames of one pass held for both the
                 # bootstrap and the tracking pass, the reader's warnings held per frame as the
                 # tracking pass holds them (was: a pass for the bootstrap, another to track).
-                # With threads only: there it saves 0.4-0.6 s of PETS09's 4-6 s of CPU; on
-                # one thread it saves nothing (faulting in 412 MB costs what the pass did)
+                # With threads only: there it saved medians of 0.47-0.51 s of PETS09's
+                # 4.4-6.4 s of CPU; on one thread nothing (faulting in 412 MB costs about
+                # what the bootstrap's pass did; docs/results.md, stop 66)
                 if bootstrap == "spread" and threads:
                     one_pass = frames.held_frames(
                         hold_budget(),
