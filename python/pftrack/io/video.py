@@ -2623,6 +2623,76 @@ class FrameSource:
         finally:
             cap.release()
 
+    def held_frames(
+        self,
+        budget: int,
+        wrap: Callable[[Iterator[NDArray[np.uint8]]], Iterator[NDArray[np.uint8]]] | None = None,
+    ) -> list[NDArray[np.uint8]] | None:
+        """Every frame of a video file, read in one pass and held, when they fit `budget` bytes.
+
+        For a run that would otherwise decode the file twice (the spread bootstrap's pass, then
+        the tracking pass): the frames are those iterating gives, read as iterating reads them
+        (`wrap`, optional, is applied to the iterator: the tracking pass's warnings held per
+        frame, :func:`pftrack.tracking.run.track_frames`). None, and the source as it was
+        before (its once-only warnings not spent, :meth:`stop` kept), when holding does not
+        apply or does not pay: a live source or an image folder (a folder reads only the chosen
+        images), a count not known, frames that do not fit `budget` (their header count times
+        their size), an intra-only file whose spread pass decodes only the chosen packets
+        (:mod:`pftrack.io.packets`); or when the pass found what the two passes read otherwise
+        (frames other than its header's count, frames that failed to decode, a stop).
+        """
+        if (
+            self.live
+            or self._images is not None
+            or self.path is None
+            or not self.count_known
+            or self.stopped
+            or self.n_frames * self.width * self.height * 3 > budget
+        ):
+            return None
+        if self._packet_pass():
+            return None
+        before = dict(vars(self))
+        held: list[NDArray[np.uint8]] = []
+        frames = self._iterate()
+        reads = wrap(frames) if wrap is not None else frames
+        whole = False
+        try:
+            for frame in reads:
+                if len(held) == self.n_frames:
+                    break  # more than its header says: the bootstrap counts them its way
+                held.append(frame)
+            else:
+                whole = True
+        finally:
+            close = getattr(reads, "close", None)
+            if close is not None:
+                close()
+            frames.close()
+        if not whole or len(held) != self.n_frames or self.lead_black or self._said_lost:
+            stopped = self.stopped
+            vars(self).update(before)  # as if this pass had not been read
+            self.stopped = stopped
+            return None
+        return held
+
+    def _packet_pass(self) -> bool:
+        """Whether the spread bootstrap's pass of this file may read packets (MJPEG), not frames.
+
+        :meth:`_intra_frames_at`'s first test, on the whole file: its codec, and the pixels of
+        its frames (the few chosen ones not taken off).
+        """
+        if self.path is None:
+            return False
+        cap = _file_capture(str(self.path))
+        try:
+            if _fourcc(cap) not in INTRA_FOURCCS:
+                return False
+            size = cap.get(cv2.CAP_PROP_FRAME_WIDTH) * cap.get(cv2.CAP_PROP_FRAME_HEIGHT)
+        finally:
+            cap.release()
+        return self.n_frames * size >= PACKET_PASS_MIN_PIXELS
+
     def stop(self) -> None:
         """End every read under way before its next frame (safe to call from a signal handler).
 
