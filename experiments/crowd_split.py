@@ -59,8 +59,8 @@ def _source(name: str, data: Path, crowd: Path) -> tuple[object, F64, float]:
         d = crowd / f"c{n}s{s}"
         return d / "crowd.avi", read_mot(d / "gt.txt"), 1.0
     seed = int(rest)
-    scene = make_scene(n_frames=150, rng=seed) if kind == "walkers" else make_busy_scene(
-        kind, rng=seed
+    scene = (
+        make_scene(n_frames=150, rng=seed) if kind == "walkers" else make_busy_scene(kind, rng=seed)
     )
     return list(scene.frames), scene.truth, 1.0
 

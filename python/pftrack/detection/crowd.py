@@ -110,9 +110,7 @@ def split_crowds(
     return np.ascontiguousarray(np.vstack(out_b)), np.concatenate(out_s)
 
 
-def _people(
-    mask: NDArray[np.uint8], box: F64, lines: F64, rows: int, cols: int
-) -> F64 | None:
+def _people(mask: NDArray[np.uint8], box: F64, lines: F64, rows: int, cols: int) -> F64 | None:
     """The people of one blob's box read from its head tops, or None for fewer than two.
 
     A head top is a column where the blob's upper outline (its first foreground row) is
@@ -171,8 +169,9 @@ def _own_pixels(crop: NDArray[np.uint8]) -> NDArray[np.bool_]:
     n, labels, stats, _ = cv2.connectedComponentsWithStats(
         (crop != 0).view(np.uint8), connectivity=8
     )
+    fg: NDArray[np.bool_] = crop != 0
     if n <= 2:
-        return crop != 0
+        return fg
     own = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
     out: NDArray[np.bool_] = labels == own
     return out

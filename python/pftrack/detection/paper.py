@@ -19,6 +19,7 @@ from pftrack.detection.base import (
     Detections,
     check_frame,
 )
+from pftrack.detection.crowd import split_crowds
 from pftrack.detection.ghost import GHOST_STATISTICS
 from pftrack.detection.hold import StopMemory
 from pftrack.detection.light import (
@@ -29,7 +30,6 @@ from pftrack.detection.light import (
     looks_grey,
     sample_step,
 )
-from pftrack.detection.crowd import split_crowds
 from pftrack.detection.size_model import PersonSizeModel
 from pftrack.particle_filter.colour import HsvBinning, hsv_bins
 
