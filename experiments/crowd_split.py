@@ -67,6 +67,17 @@ def _source(name: str, data: Path, crowd: Path) -> tuple[object, F64, float]:
     return list(scene.frames), scene.truth, 1.0
 
 
+def _known(name: str) -> bool:
+    """Whether `name` is a sequence name `_source` reads."""
+    kind, _, rest = name.partition(":")
+    parts = rest.split(":") if rest else []
+    if kind in ("pets", "tud"):
+        return not parts
+    want = 2 if kind == "crowd" else 1
+    kinds = ("crowd", "walkers", "present", "groups", "overhead")
+    return kind in kinds and len(parts) == want and all(q.isdigit() for q in parts)
+
+
 def _iou(a: F64, b: F64) -> F64:
     lo = np.maximum(a[:, None, :2], b[None, :, :2])
     hi = np.minimum(a[:, None, :2] + a[:, None, 2:], b[None, :, :2] + b[None, :, 2:])
@@ -112,6 +123,13 @@ def coverage(src: object, truth: F64, scale: float, split: bool) -> dict[str, ob
     """
     timed = _Timed()
     paper.split_crowds = timed  # type: ignore[assignment]  # the detector's own call, timed
+    try:
+        return _count(src, truth, scale, split, timed)
+    finally:
+        paper.split_crowds = crowd.split_crowds
+
+
+def _count(src: object, truth: F64, scale: float, split: bool, timed: _Timed) -> dict[str, object]:
     det = PaperDetector(PaperConfig(crowd_split=split))
     frames = src if isinstance(src, list) else FrameSource(src)  # type: ignore[arg-type]
     det.prime(bootstrap_frames(frames))
@@ -177,11 +195,18 @@ def main(argv: Sequence[str] | None = None) -> None:
     p.add_argument("--variants", default="base,split", help="base, split or both")
     p.add_argument("--coverage", action="store_true", help="the detector alone")
     args = p.parse_args(argv)
+    names = args.seqs.split(",")
+    for name in names:
+        if not _known(name):
+            p.error(f"--seqs: {name!r} is not pets, tud, crowd:N:S or KIND:SEED")
+    variants = args.variants.split(",")
+    if any(v not in VARIANTS for v in variants):
+        p.error(f"--variants: {args.variants!r}, expected base, split or base,split")
     args.out.mkdir(parents=True, exist_ok=True)
     log = args.out / "crowd_split.jsonl"
-    for name in args.seqs.split(","):
+    for name in names:
         src, truth, scale = _source(name, args.data, args.crowd)
-        for v in args.variants.split(","):
+        for v in variants:
             fn = coverage if args.coverage else tracked
             row = {"seq": name, "variant": v, "coverage": args.coverage}
             row.update(fn(src, truth, scale, VARIANTS[v]))
