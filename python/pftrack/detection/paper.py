@@ -19,6 +19,7 @@ from pftrack.detection.base import (
     Detections,
     check_frame,
 )
+from pftrack.detection.crowd import split_crowds
 from pftrack.detection.ghost import GHOST_STATISTICS
 from pftrack.detection.hold import StopMemory
 from pftrack.detection.light import (
@@ -145,6 +146,11 @@ class PaperConfig:
         to 1: people's contrast, and the noise, scale with the light when it dims; a video
         brighter than its first frame keeps the bounds as given (its first frame may have been
         dim: a fade-in).
+    crowd_split : bool
+        Once the person-size model is fitted, read a blob taller or wider than one person
+        from its head tops into one box per person (`pftrack.detection.crowd.split_crowds`:
+        people one behind the other, or side by side with no valley between them). Off by
+        default (docs/detection.md, "Crowds: merged people read from their head tops").
     blobs : BlobConfig
         Morphology and blob filters.
     hsv : HsvBinning
@@ -170,6 +176,7 @@ class PaperConfig:
     gain_band: float = 0.03
     gain_thresholds: bool = True
     hold_frames: int = 0
+    crowd_split: bool = False
     blobs: BlobConfig = field(default_factory=BlobConfig)
     hsv: HsvBinning = field(default_factory=HsvBinning)
 
@@ -188,6 +195,7 @@ class PaperConfig:
         )  # 0 or 1: the selective update at once
         integer(self.hold_frames, f"{own}: hold_frames", 0, 2**31 - 1)
         flag(self.gain_thresholds, f"{own}: gain_thresholds")
+        flag(self.crowd_split, f"{own}: crowd_split")
         instance(self.blobs, f"{own}: blobs", BlobConfig)
         instance(self.hsv, f"{own}: hsv", HsvBinning)
         if not (0.0 <= self.ghost_support <= 1.0):
@@ -548,6 +556,8 @@ class PaperDetector:
         if self.config.ghost_support > 0 and len(boxes):
             mask, boxes, scores = self._drop_ghosts(frame, mask, boxes, scores)
         size = self._blobs.size_model
+        if self.config.crowd_split and len(boxes) and size.fitted:
+            boxes, scores = split_crowds(mask, boxes, scores, size)
         if self.config.leg_height > 0 and len(boxes) and size.fitted:
             # after the size model observed the blobs' own boxes (it never learns from these);
             # no box grows into a ghost (this frame's ghost pixels are background being learnt)
