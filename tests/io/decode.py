@@ -38,3 +38,13 @@ def capture_frames(path: Path) -> list[np.ndarray]:
         frames.append(frame)
     cap.release()
     return frames
+
+
+def grabs_before_failure(path: Path) -> int:
+    """The frames ``cv2.VideoCapture`` grabs of the video before its first failure."""
+    cap = cv2.VideoCapture(str(path))
+    n = 0
+    while cap.grab():
+        n += 1
+    cap.release()
+    return n

@@ -11,12 +11,12 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
-import cv2
 import pytest
 
 from pftrack.cli import main
 from pftrack.io.video import FrameSource
 from pftrack.synthetic import Scene, make_scene
+from tests.io.decode import grabs_before_failure
 from tests.io.test_estimated_count import VARIABLE, write_vfr
 
 pytest.importorskip("av")
@@ -28,16 +28,6 @@ def said_of(n: int) -> str:
         f"ended after {n} frames but its container says 6.0 s (frame {n} is at "
         f"{(n - 1) / 10:.1f} s): a truncated or damaged file?"
     )
-
-
-def decoded(video: Path) -> int:
-    """The frames OpenCV decodes of `video`, counted apart from pftrack."""
-    cap = cv2.VideoCapture(str(video))
-    n = 0
-    while cap.grab():
-        n += 1
-    cap.release()
-    return n
 
 
 @pytest.fixture(scope="module")
@@ -71,7 +61,7 @@ def test_a_whole_file_is_not_called_damaged(whole: Path) -> None:
 
 def test_reading_a_cut_file_names_it_and_its_last_frame(whole: Path) -> None:
     video = cut(whole, 0.5)
-    n = decoded(video)
+    n = grabs_before_failure(video)
     assert 1 < n < 50  # the test's premise: FFmpeg decodes the frames before the cut
     assert frames_and_warnings(video) == (n, [f"{video} {said_of(n)}"])
 
@@ -91,4 +81,4 @@ def test_pftrack_track_of_a_cut_file_warns_and_exits_0(
         code = main(["-q", "track", str(video), *args, "--out", str(tmp_path / "t.txt")])
     assert code == 0
     err = capsys.readouterr().err
-    assert err.count(f"warning: {video} {said_of(decoded(video))}\n") == 1, err
+    assert err.count(f"warning: {video} {said_of(grabs_before_failure(video))}\n") == 1, err

@@ -13,30 +13,20 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
-import cv2
 import numpy as np
 
 from pftrack.cli import main
 from pftrack.io.video import FrameSource
 from pftrack.synthetic import make_scene
+from tests.io.decode import grabs_before_failure
 from tests.io.test_video import damaged_inside
-
-
-def grabbed_before_failure(video: Path) -> int:
-    """The frames OpenCV grabs of `video` before its first failure, counted apart."""
-    cap = cv2.VideoCapture(str(video))
-    n = 0
-    while cap.grab():
-        n += 1
-    cap.release()
-    return n
 
 
 def test_the_count_goes_on_past_a_frame_that_fails_to_decode(tmp_path: Path) -> None:
     """30 frames, frame 10 damaged: counted 30, as read, with no count warning (was: 9, and
     ``its header says 30 frames but it holds 9 (counted)``)."""
     damaged = damaged_inside(tmp_path)
-    assert grabbed_before_failure(damaged) == 9  # the case: OpenCV's grabs stop there
+    assert grabs_before_failure(damaged) == 9  # the case: OpenCV's grabs stop there
     source = FrameSource(damaged)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -67,7 +57,7 @@ def test_a_run_whose_last_frame_is_lost_tracks_the_frames_after_the_damage(
     """The spread bootstrap misses the last frame and recounts: the run tracks the 44 frames
     read, not the 13 before the damage (was: "its header says 45 frames but it holds 13")."""
     damaged = damaged_and_last_lost(tmp_path)
-    before = grabbed_before_failure(damaged)
+    before = grabs_before_failure(damaged)
     with warnings.catch_warnings(record=True):
         warnings.simplefilter("always")
         read = len(list(FrameSource(damaged)))
