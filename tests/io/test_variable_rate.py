@@ -8,16 +8,16 @@ frames evenly spaced, and the tracker takes every step between frames as one: wi
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
 
+import numpy as np
 import pytest
 
 from pftrack.cli import main
 from pftrack.io.mot import write_mot
 from pftrack.io.video import UNEVEN_FIRST_CHECK, FrameSource
 from pftrack.synthetic import Scene, make_scene
-from pftrack.tracking.api import Tracker
 from tests.io.test_estimated_count import write_vfr
 
 pytest.importorskip("av")
@@ -106,22 +106,19 @@ def test_track_says_it_while_tracking_not_after(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """``pftrack track`` printed the warnings raised while tracking once the run was over (an
-    hour's video: an hour late); each is now printed as it is raised, at the frame being
-    tracked when it was read (a run that holds the frames of one pass reads them all before
-    frame 1 is tracked, and gives each warning at the frame the tracking pass gave it: hold66)."""
+    hour's video: an hour late); each is now printed as it is raised."""
     long = make_scene(120, 96, 64, n_walkers=1, rng=2)
     video = write_vfr(tmp_path / "vfr.mp4", long, [100, 200] * 60)
-    seen: list[str] = []  # stderr by the 60th frame tracked
-    update = Tracker.update
-    tracked = [0]
+    seen: list[str] = []  # stderr by the 60th frame read
+    iterate = FrameSource.__iter__
 
-    def watched(self: Tracker, *args: Any, **kwargs: Any) -> Any:
-        tracked[0] += 1
-        if tracked[0] == 60 and not seen:
-            seen.append(capsys.readouterr().err)
-        return update(self, *args, **kwargs)
+    def watched(self: FrameSource) -> Iterator[np.ndarray]:
+        for n, frame in enumerate(iterate(self), start=1):
+            if n == 60 and not seen:
+                seen.append(capsys.readouterr().err)
+            yield frame
 
-    monkeypatch.setattr(Tracker, "update", watched)
+    monkeypatch.setattr(FrameSource, "__iter__", watched)
     assert main(["-q", "track", str(video), "--out", str(tmp_path / "t.txt")]) == 0
     assert seen and seen[0].count("variable frame rate: its first 50 frames") == 1
     assert "variable frame rate" not in capsys.readouterr().err  # not again at the end

@@ -239,11 +239,7 @@ def track_frames(
         of a file at once for the spread bootstrap (``bootstrap_frames(split=True)``). False
         does all the work on the calling thread, with the same rows: for a process that already
         has one task per core, such as a worker of ``pftrack batch``, where the extra threads
-        only cost CPU. With threads, a video file the spread bootstrap would decode whole
-        (not MJPEG, whose chosen frames decode alone) is decoded once when its frames fit
-        :func:`hold_budget` (``PFTRACK_HOLD_MB``; by default the smaller of 1 GiB and a quarter
-        of the memory available): the frames of that one pass are held for the bootstrap and
-        the tracking pass (:meth:`FrameSource.held_frames`), the same rows.
+        only cost CPU.
 
     Raises
     ------
@@ -323,10 +319,6 @@ def track_frames(
     # track_frames, or track_path, not this module's loop
     tracker._caller_depth = _calls_from_here(sys._getframe(1))
     _refuse_stopped(frames)
-    # the reader's warnings (a damaged start, a variable frame rate), on a reading thread with
-    # threads: held there, given here from the caller's line before the frame read with them
-    said: deque[_Said] = deque()
-    one_pass: list[NDArray[np.uint8]] | None = None  # a pass held for tracking too
     if prime_frames > 0 and (detections is None or config.refine.enabled):
         if bootstrap == "auto":
             bootstrap = "spread" if detections is None else "first"
@@ -347,28 +339,9 @@ def track_frames(
                         bar.set(min(next(read), n_prime))
                     return kept
 
-                # one decode where they fit: the frames of one pass held for both the
-                # bootstrap and the tracking pass, the reader's warnings held per frame as the
-                # tracking pass holds them (was: a pass for the bootstrap, another to track).
-                # With threads only: there it saved medians of 0.47-0.51 s of PETS09's
-                # 4.4-6.4 s of CPU; on one thread nothing (faulting in 412 MB costs about
-                # what the bootstrap's pass did; docs/results.md, stop 66)
-                if bootstrap == "spread" and threads:
-                    one_pass = frames.held_frames(
-                        hold_budget(),
-                        lambda it: _reading(_counting(it, frames.n_frames, n_prime, bar), said),
-                    )
-                    if one_pass is None:
-                        said.clear()  # a pass undone: its warnings are given by the next
-                        _refuse_stopped(frames)  # stopped inside it: said as after the pass
-                if one_pass is not None:  # the bar drawn by the pass already
-                    primer = bootstrap_frames(
-                        one_pass, prime_frames, bootstrap, prepare=tracker.working_frame
-                    )
-                else:
-                    primer = bootstrap_frames(
-                        frames, prime_frames, bootstrap, split=threads, prepare=prepare
-                    )
+                primer = bootstrap_frames(
+                    frames, prime_frames, bootstrap, split=threads, prepare=prepare
+                )
             if primer:
                 tracker.prime(primer, shape=(frames.height, frames.width, 3))
         else:  # frames in memory already, checked as the caller gave them (was: "prime frame
@@ -392,7 +365,10 @@ def track_frames(
         """Whether frame k is black in place of one the video could not decode, once read."""
         return k <= getattr(frames, "lead_black", 0)
 
-    reads = _reading(frames, said) if one_pass is None else _handed(one_pass)
+    # the reader's warnings (a damaged start, a variable frame rate), on a reading thread with
+    # threads: held there, given here from the caller's line before the frame read with them
+    said: deque[_Said] = deque()
+    reads = _reading(frames, said)
     if not threads:
         stream: Any = closing(reads)
     elif ahead:
@@ -447,56 +423,6 @@ def track_frames(
     return TrackingRun(rows, n, time.perf_counter() - start)
 
 
-#: The environment variable that sets :func:`hold_budget`, in MB (0: never hold).
-HOLD_VARIABLE = "PFTRACK_HOLD_MB"
-#: The most a run holds of decoded frames by default, in bytes (PETS09-S2L1's 795 frames of
-#: 480x360: 412 MB; a minute of 1280x720 at 25 fps: 4.1 GB, not held).
-HOLD_CAP = 1 << 30
-#: The share of the memory available when the run starts that it may hold by default.
-HOLD_SHARE = 0.25
-
-
-def hold_budget() -> int:
-    """Bytes of decoded frames :func:`track_frames` may hold to decode a file once.
-
-    ``PFTRACK_HOLD_MB`` (MB of 2**20 bytes, an int >= 0; 0: never hold), else the smaller of
-    :data:`HOLD_CAP` and :data:`HOLD_SHARE` of the memory available (Linux's
-    ``MemAvailable``; the cap alone where it cannot be read). Frames of a file that do not fit
-    are decoded twice instead, as before: once for the spread bootstrap, once to track.
-
-    Raises
-    ------
-    ValueError
-        ``PFTRACK_HOLD_MB`` is not an int >= 0.
-    """
-    text = os.environ.get(HOLD_VARIABLE)
-    if text is not None and text.strip():
-        try:
-            mb = int(text)
-        except ValueError:
-            mb = -1
-        if mb < 0:
-            raise ValueError(
-                f"{HOLD_VARIABLE} is {text!r}, expected an int >= 0 (MB of decoded frames a "
-                "run may hold to decode a video once; 0: never)"
-            )
-        return mb << 20
-    available = _available_memory()
-    return HOLD_CAP if available is None else min(HOLD_CAP, int(available * HOLD_SHARE))
-
-
-def _available_memory() -> int | None:
-    """Bytes of memory available (``MemAvailable`` of ``/proc/meminfo``), or None."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        return None
-    return None
-
-
 def _refuse_stopped(source: Any) -> None:
     """Raise "stopped before its first frame" for a source whose ``stop()`` was called.
 
@@ -526,32 +452,6 @@ def _reading(frames: Iterable[Any], said: deque[_Said]) -> Iterator[Any]:
             said.extend((k, message, category) for message, category in held.pending)
             if frame is end:
                 return
-            yield frame
-    finally:
-        close = getattr(it, "close", None)
-        if close is not None:
-            close()
-
-
-def _handed(held: list[NDArray[np.uint8]]) -> Iterator[NDArray[np.uint8]]:
-    """The frames of `held`, in order, each let go of as it is handed on (the list emptied).
-
-    The memory of the frames tracked is freed as the run goes, not at its end.
-    """
-    held.reverse()
-    while held:
-        yield held.pop()
-
-
-def _counting(
-    frames: Iterator[NDArray[np.uint8]], whole: int, n_prime: int, bar: Bar
-) -> Iterator[NDArray[np.uint8]]:
-    """`frames`, moving the bootstrap's bar of `n_prime` by the share of the `whole` read."""
-    it = iter(frames)
-    try:
-        for k, frame in enumerate(it, start=1):
-            if bar.enabled:
-                bar.set(min(n_prime * k // max(whole, 1), n_prime))
             yield frame
     finally:
         close = getattr(it, "close", None)
