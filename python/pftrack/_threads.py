@@ -6,16 +6,21 @@ A Dask worker of ``pftrack batch`` runs one task per core already: its plugin se
 
 from __future__ import annotations
 
+import glob
 import os
 import threading
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 __all__ = [
     "BLAS_THREAD_VARIABLES",
+    "blas_on_one_thread",
     "MAX_KERNEL_THREADS",
     "WORKER_THREADS_VARIABLE",
     "join_through_interrupts",
     "kernel_threads",
     "one_blas_thread",
+    "openblas_threads",
     "tracking_threads",
     "usable_cpus",
     "wait_through_interrupts",
@@ -79,6 +84,90 @@ def one_blas_thread() -> None:
     """
     for name in BLAS_THREAD_VARIABLES:
         os.environ.setdefault(name, "1")
+
+
+#: The (get, set) symbol pairs of the OpenBLAS NumPy's wheels carry (64-bit integers, and the
+#: 32-bit one).
+_OPENBLAS_SYMBOLS = (
+    ("scipy_openblas_get_num_threads64_", "scipy_openblas_set_num_threads64_"),
+    ("scipy_openblas_get_num_threads", "scipy_openblas_set_num_threads"),
+)
+#: OpenBLAS's (get, set) of its thread count in this process: None until first asked, then
+#: the pair, or False where NumPy's BLAS is not an OpenBLAS found by :func:`openblas_threads`.
+_OPENBLAS: tuple[Callable[[], int], Callable[[int], object]] | bool | None = None
+#: Held while the count is lowered (one setting a process: two threads lowering it at once
+#: would restore each other's count, and run at the pool's).
+_BLAS_LOCK = threading.Lock()
+
+
+@contextmanager
+def blas_on_one_thread() -> Iterator[None]:
+    """Run the block's BLAS calls on one thread: :func:`one_blas_thread` once NumPy is loaded.
+
+    With NumPy's BLAS the OpenBLAS of NumPy's wheels at more than one thread, its count is set
+    to 1 for the block and set back after it, under a lock; the block's products are then one
+    thread's, the bits of a process started with ``OPENBLAS_NUM_THREADS=1``. The count is the
+    process's: a BLAS call of another thread inside the block runs on one thread too. Any other
+    BLAS (MKL, Accelerate, a system OpenBLAS), or a count of 1 already: the block as it is.
+    For short blocks (a product of a frame), not for long work.
+    """
+    blas = openblas_threads()
+    if not isinstance(blas, tuple):
+        yield
+        return
+    get, put = blas
+    with _BLAS_LOCK:
+        before = get()
+        if before <= 1:
+            yield
+            return
+        put(1)
+        try:
+            yield
+        finally:
+            put(before)
+
+
+def openblas_threads() -> tuple[Callable[[], int], Callable[[int], object]] | bool:
+    """OpenBLAS's get and set of its thread count in NumPy's BLAS (False: none found).
+
+    The library is the one NumPy's wheels carry beside it (``numpy.libs``, ``numpy/.dylibs``),
+    opened by ``ctypes`` only if it is loaded already (the copy NumPy calls; OpenCV's wheels
+    carry another, whose count is not NumPy's); the pair is its ``get_num_threads`` and
+    ``set_num_threads``, looked up once a process.
+    """
+    global _OPENBLAS
+    if _OPENBLAS is None:
+        _OPENBLAS = _find_openblas() or False
+    return _OPENBLAS
+
+
+def _find_openblas() -> tuple[Callable[[], int], Callable[[int], object]] | None:
+    """:func:`openblas_threads`' pair, looked up; None for a NumPy on another BLAS."""
+    import ctypes  # here: the command imports this module at its start, for one_blas_thread
+
+    import numpy as np  # (before NumPy loads)
+
+    noload = getattr(os, "RTLD_NOLOAD", 0) | ctypes.RTLD_LOCAL  # open only if loaded already
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(np.__file__)))
+    paths = [
+        path
+        for pattern in ("numpy.libs/*openblas*", "numpy/.dylibs/*openblas*")
+        for path in sorted(glob.glob(os.path.join(root, pattern)))
+    ]
+    for path in paths:
+        try:
+            lib = ctypes.CDLL(path, mode=noload)
+        except OSError:
+            continue
+        for get_name, set_name in _OPENBLAS_SYMBOLS:
+            get, put = getattr(lib, get_name, None), getattr(lib, set_name, None)
+            if get is not None and put is not None:
+                get.restype, get.argtypes = ctypes.c_int, []
+                put.restype, put.argtypes = None, [ctypes.c_int]
+                return get, put
+    return None
 
 
 def join_through_interrupts(thread: threading.Thread, finished: threading.Event) -> None:

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pftrack import _threads
 from pftrack.tracking import AssociationConfig, association
 
 
@@ -46,7 +47,7 @@ def test_a_padding_matrix_too_large_to_keep_is_the_same_matrix() -> None:
 
 
 def _blas_or_skip() -> tuple[Callable[[], int], Callable[[int], object]]:
-    blas = association._openblas()
+    blas = _threads.openblas_threads()
     if not isinstance(blas, tuple):
         pytest.skip("NumPy's BLAS is not the OpenBLAS of NumPy's wheels")
     return blas

@@ -10,18 +10,15 @@ costs ``unmatched_cost`` each, so a gated pair is only made when it is cheaper t
 
 from __future__ import annotations
 
-import ctypes
-import glob
 import math
-import os
-import threading
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from pftrack import _core
+from pftrack._threads import blas_on_one_thread
 from pftrack._typing import F64
 from pftrack.boxes import _iou_matrix
 from pftrack.tracking.config import AssociationConfig
@@ -123,13 +120,6 @@ def associate(
 #: detections of 110 bins: 11,000.
 ONE_THREAD_PRODUCT = 65536
 
-#: OpenBLAS's (get, set) of its thread count in this process: None until first asked, then
-#: the pair, or False where NumPy's BLAS is not an OpenBLAS found by :func:`_find_openblas`.
-_OPENBLAS: tuple[Callable[[], int], Callable[[int], object]] | bool | None = None
-#: Held around a product with the thread count lowered (one setting a process: two trackers
-#: in two threads would otherwise restore each other's count, and run at the pool's).
-_BLAS_LOCK = threading.Lock()
-
 
 def colour_product(a: F64, b: F64) -> F64:
     """``a @ b`` on one BLAS thread: the bits of ``OPENBLAS_NUM_THREADS=1``, the pool's never.
@@ -141,81 +131,16 @@ def colour_product(a: F64, b: F64) -> F64:
     differ from one thread's in their last bits (10 of 18 shapes from 70 x 70 on), so a
     library tracker of 70+ tracks weighed its pairs otherwise than ``pftrack track`` (one BLAS
     thread from its start, :func:`pftrack._threads.one_blas_thread`) and than itself on a
-    machine of another core count. Above :data:`ONE_THREAD_PRODUCT` multiply-adds, with
-    NumPy's BLAS the OpenBLAS of NumPy's wheels at more than one thread, the count is set to
-    1 for the product and set back after it (under a lock): the product is one thread's, the
-    same bits as ``pftrack track``'s (tests/tracking/test_association.py). The count is the
-    process's: a BLAS call of another thread that falls inside those microseconds runs on one
-    thread too. Any other BLAS (MKL, Accelerate, a system OpenBLAS): the plain product.
+    machine of another core count. Above :data:`ONE_THREAD_PRODUCT` multiply-adds the product
+    runs inside :func:`pftrack._threads.blas_on_one_thread`: one thread's, the same bits as
+    ``pftrack track``'s (tests/tracking/test_association.py).
     """
     if a.shape[0] * a.shape[1] * b.shape[1] <= ONE_THREAD_PRODUCT:
         out: F64 = a @ b
         return out
-    blas = _openblas()
-    if not isinstance(blas, tuple):
+    with blas_on_one_thread():
         out = a @ b
-        return out
-    get, put = blas
-    with _BLAS_LOCK:
-        before = get()
-        if before <= 1:
-            out = a @ b
-            return out
-        put(1)
-        try:
-            out = a @ b
-        finally:
-            put(before)
     return out
-
-
-def _openblas() -> tuple[Callable[[], int], Callable[[int], object]] | bool:
-    """OpenBLAS's get and set of its thread count in NumPy's BLAS (False: none found)."""
-    global _OPENBLAS
-    if _OPENBLAS is None:
-        _OPENBLAS = _find_openblas() or False
-    return _OPENBLAS
-
-
-#: The (get, set) symbol pairs of the OpenBLAS NumPy's wheels carry (64-bit integers, and the
-#: 32-bit one).
-_OPENBLAS_SYMBOLS = (
-    ("scipy_openblas_get_num_threads64_", "scipy_openblas_set_num_threads64_"),
-    ("scipy_openblas_get_num_threads", "scipy_openblas_set_num_threads"),
-)
-
-
-#: dlopen's flag to open a library only if it is loaded already (none on Windows).
-_NOLOAD = getattr(os, "RTLD_NOLOAD", 0) | ctypes.RTLD_LOCAL
-
-
-def _find_openblas() -> tuple[Callable[[], int], Callable[[int], object]] | None:
-    """The thread-count pair of the OpenBLAS this process has loaded for NumPy, or None.
-
-    The library is the one NumPy's wheels carry beside it (``numpy.libs``, ``numpy/.dylibs``),
-    opened by ``ctypes`` only if it is loaded already (the copy NumPy calls); the pair is its
-    ``get_num_threads`` and ``set_num_threads``. A NumPy built on a system BLAS: None.
-    """
-    # NumPy's own copy, beside it: another OpenBLAS may be loaded too (OpenCV's wheels carry
-    # one), and its thread count is not NumPy's
-    root = os.path.dirname(os.path.dirname(os.path.abspath(np.__file__)))
-    paths = [
-        path
-        for pattern in ("numpy.libs/*openblas*", "numpy/.dylibs/*openblas*")
-        for path in sorted(glob.glob(os.path.join(root, pattern)))
-    ]
-    for path in paths:
-        try:
-            lib = ctypes.CDLL(path, mode=_NOLOAD)  # only a copy already loaded
-        except OSError:
-            continue
-        for get_name, set_name in _OPENBLAS_SYMBOLS:
-            get, put = getattr(lib, get_name, None), getattr(lib, set_name, None)
-            if get is not None and put is not None:
-                get.restype, get.argtypes = ctypes.c_int, []
-                put.restype, put.argtypes = None, [ctypes.c_int]
-                return get, put
-    return None
 
 
 #: Padded cost matrices made so far, by (tracks, detections, unmatched cost): a frame's
