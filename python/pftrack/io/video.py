@@ -969,33 +969,26 @@ def _stamp_index(cap: cv2.VideoCapture, rate: float) -> int:
 
 
 def _resume(
-    cap: cv2.VideoCapture, rate: float, start: int, at: int, n_frames: int
-) -> tuple[int, NDArray[Any]] | None:
+    cap: cv2.VideoCapture,
+    rate: float,
+    start: int,
+    at: int,
+    n_frames: int,
+    read: Callable[[], tuple[bool, Any]],
+) -> tuple[int, Any] | None:
     """The next frame that decodes after a failure at frame `at`, with its index.
 
     A damaged packet in the middle of a file (bytes overwritten) fails one read, and FFmpeg
     decodes on from the next frame: its time stamp (less the first frame's, `start`) says
-    which one it is. None when none of :data:`RESUME_TRIES` reads decodes, or its stamp is
-    not a later frame of the header's.
+    which one it is. `read`: ``cap.read`` (the frame comes back), or a pass of grabs' step
+    (``lambda: (cap.grab(), None)``). None when none of :data:`RESUME_TRIES` reads decodes, or
+    its stamp is not a later frame of the header's.
     """
     for _ in range(RESUME_TRIES):
-        ok, frame = cap.read()
+        ok, frame = read()
         if ok:
             index = _stamp_index(cap, rate) - start
             return (index, frame) if at <= index < max(n_frames, at + 1) else None
-    return None
-
-
-def _resume_grab(
-    cap: cv2.VideoCapture, rate: float, start: int, at: int, n_frames: int
-) -> int | None:
-    """:func:`_resume` for a pass of grabs: the index of the next frame that decodes, or None."""
-    if rate <= 0 or at >= n_frames:
-        return None
-    for _ in range(RESUME_TRIES):
-        if cap.grab():
-            index = _stamp_index(cap, rate) - start
-            return index if at <= index < n_frames else None
     return None
 
 
@@ -2356,10 +2349,14 @@ class FrameSource:
                 # a frame inside that fails to decode: reading goes on past it, with the
                 # frame before standing in (_iter_stored), so the count does too (was: the
                 # frames before it taken as the video's, a run cut there, "it holds 14")
-                at = _resume_grab(cap, rate, start, found, self.n_frames) if timed else None
-                if at is None:
+                if not timed or found >= self.n_frames:
                     break
-                found = at + 1
+                resumed = _resume(
+                    cap, rate, start, found, self.n_frames, lambda: (cap.grab(), None)
+                )
+                if resumed is None:
+                    break
+                found = resumed[0] + 1
                 last_ms = float(cap.get(cv2.CAP_PROP_POS_MSEC))
         finally:
             cap.release()
@@ -2684,7 +2681,7 @@ class FrameSource:
                 if not ok:
                     if not timed or decoded >= self.n_frames:
                         break
-                    resumed = _resume(cap, rate, start, decoded, self.n_frames)
+                    resumed = _resume(cap, rate, start, decoded, self.n_frames, cap.read)
                     if resumed is None:
                         break
                     index, frame = resumed
