@@ -510,3 +510,40 @@ def test_a_batch_sequence_whose_rename_fails_keeps_its_earlier_outputs(
     (out / "a.mp4").rmdir()
     assert main(argv) == 0
     assert _statuses(out) == {"a": "done", "b": "skipped"}
+
+
+def test_a_ctrl_c_inside_importlib_is_raised_on_the_next_line_outside_it() -> None:
+    """The console's handler, called in importlib's frozen frames, raises nothing there: C that
+    imports (an extension's init: OpenCV's import_array) printed the KeyboardInterrupt raised
+    into it as a traceback (``File "<frozen importlib._bootstrap>", line 216, in
+    _lock_unlock_module``, then ``pftrack recover: interrupted``: CI, 7 December). It notes
+    the interrupt and raises the signal again, so the next line outside raises it."""
+    import signal
+    import sys
+    import types
+
+    from pftrack._console import _on_sigint
+
+    importlib_code = compile("pass", "<frozen importlib._bootstrap>", "exec")
+    inside = types.SimpleNamespace(f_code=importlib_code)
+    seen: list[int] = []
+    before = signal.signal(signal.SIGINT, lambda signum, frame: seen.append(signum))
+    try:
+        try:
+            _on_sigint(signal.SIGINT, inside)
+        except KeyboardInterrupt:
+            pytest.fail("raised inside importlib's frames")  # was: raised here
+        for _ in range(1000):  # Python runs the handler between bytecodes
+            pass
+        assert seen == [signal.SIGINT]  # raised again, for the next line
+        assert _interrupt.interrupted()
+        signal.signal(signal.SIGINT, _on_sigint)  # the console's: it raises on a line outside
+        with pytest.raises(KeyboardInterrupt):
+            _on_sigint(signal.SIGINT, inside)
+            for _ in range(1000):
+                pass
+            pytest.fail("the interrupt put off was never raised")
+        with pytest.raises(KeyboardInterrupt):  # anywhere else: at once
+            _on_sigint(signal.SIGINT, sys._getframe())
+    finally:
+        signal.signal(signal.SIGINT, before)
