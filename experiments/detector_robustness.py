@@ -25,7 +25,11 @@ Usage (from the repository root)::
     python -m experiments.detector_robustness [--data ../shared/data]
         [--sequences pets,tud,walkers,present,groups,overhead] [--variants ident,grey,ramp]
         [--detector paper] [--bootstrap auto] [--seed 0] [--hold-frames 0]
-        [--out out/detector_robustness]
+        [--grey-t-min T] [--grey-shadow-lo LO] [--out out/detector_robustness]
+
+``--grey-t-min`` and ``--grey-shadow-lo`` set ``PaperConfig.grey_t_min`` and
+``grey_shadow_lo`` (the built-in detector's threshold bound and shadow bound on grey video;
+colour video is not affected).
 """
 
 from __future__ import annotations
@@ -154,7 +158,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument(
         "--hold-frames", type=int, default=0, help="TrackerConfig.hold_frames (0: off, the default)"
     )
+    p.add_argument("--grey-t-min", type=float, default=None, help="PaperConfig.grey_t_min")
+    p.add_argument("--grey-shadow-lo", type=float, default=None, help="PaperConfig.grey_shadow_lo")
     args = p.parse_args(argv)
+    from pftrack.detection import PaperConfig
     from pftrack.tracking import TrackerConfig, track_frames
 
     names = [s for s in args.sequences.split(",") if s]
@@ -166,14 +173,26 @@ def main(argv: Sequence[str] | None = None) -> int:
         p.error(f"--hold-frames is {args.hold_frames}, expected 0 (off) or more")
     if args.hold_frames and args.detector != "paper":
         p.error("--hold-frames needs --detector paper (the hold is the built-in detector's)")
+    grey = {
+        k: v
+        for k, v in (("grey_t_min", args.grey_t_min), ("grey_shadow_lo", args.grey_shadow_lo))
+        if v is not None
+    }
+    if grey and args.detector != "paper":
+        p.error("--grey-t-min and --grey-shadow-lo need --detector paper")
+    try:
+        detector: str | PaperConfig = PaperConfig(**grey) if grey else args.detector
+    except ValueError as e:
+        p.error(str(e))
     data = data_root(args.data)
     header = (
         f"{'sequence':9s} {'variant':7s} {'MOTA':>6s} {'IDF1':>6s} {'HOTA':>6s} "
         f"{'FP':>5s} {'FN':>5s} {'IDSW':>4s} {'s':>6s}"
     )
     with tee_stdout(args.out / "robustness.txt"):
+        said = "".join(f" {k}={v:g}" for k, v in grey.items())
         print(
-            f"detector={args.detector} bootstrap={args.bootstrap} seed={args.seed} "
+            f"detector={args.detector}{said} bootstrap={args.bootstrap} seed={args.seed} "
             f"hold_frames={args.hold_frames} (MOTA, IDF1, HOTA in %)"
         )
         print(header)
@@ -191,7 +210,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 t0 = time.perf_counter()
                 run = track_frames(
                     source,  # type: ignore[arg-type]
-                    config=TrackerConfig(detector=args.detector, hold_frames=args.hold_frames),
+                    config=TrackerConfig(detector=detector, hold_frames=args.hold_frames),
                     rng=args.seed,
                     bootstrap=args.bootstrap,
                     show_progress=False,

@@ -302,7 +302,13 @@ def test_grey_warning_of_a_run_with_and_without_detections() -> None:
 
 
 def test_config_checks() -> None:
-    for bad in ({"grey_tolerance": -1}, {"grey_shadow_lo": 1.5}, {"gain_band": 1.0}):
+    for bad in (
+        {"grey_tolerance": -1},
+        {"grey_shadow_lo": 1.5},
+        {"gain_band": 1.0},
+        {"grey_t_min": -1.0},
+        {"grey_t_min": 61.0},  # above t_max (60)
+    ):
         with pytest.raises(ValueError, match=next(iter(bad))):
             PaperConfig(**bad)  # type: ignore[arg-type]
 
@@ -331,8 +337,11 @@ def dark_clothes(scene_rng: int = 3, n: int = 80) -> tuple[list[np.ndarray], np.
 
 @pytest.mark.filterwarnings(GREY_WARNING)
 @pytest.mark.xfail(
-    reason="known gap: with the shadow test off the grey detector still finds far fewer of "
-    "these walkers (R@0.5 0.49 against 0.90, P 0.27 against 0.72): cause not found yet",
+    reason="known gap (stop 67): the grey detector finds fewer of these walkers (R@0.5 0.84 "
+    "against 0.93, P 0.88 against 0.93; MOTA 0.74 against 0.82): a grey pixel's difference "
+    "|Y - Y_B| is below the colour test's max_c |I_c - B_c| (0.90 of the walkers' pixels pass "
+    "25 in grey, 0.97 in colour) and opening removes more of the thinner masks; with the same "
+    "boxes the tracker scores grey and colour alike (the test below)",
     strict=True,
 )
 def test_grey_scene_tracks_about_as_well_as_its_colour_version() -> None:
@@ -341,6 +350,84 @@ def test_grey_scene_tracks_about_as_well_as_its_colour_version() -> None:
     grey_score = mota([to_grey(f) for f in frames], truth)
     assert colour_score > 0.3
     assert grey_score >= colour_score - 0.05, (colour_score, grey_score)
+
+
+def detector_boxes(frames: list[np.ndarray]) -> dict[int, np.ndarray]:
+    """The built-in detector's boxes and scores of each frame (1-based), primed as the tests'."""
+    det = PaperDetector()
+    det.prime(frames[::2])
+    boxes = {}
+    for k, f in enumerate(frames, start=1):
+        d = det.detect(f)
+        boxes[k] = np.column_stack([d.boxes, d.scores]) if len(d) else np.zeros((0, 5))
+    return boxes
+
+
+def mota_of_boxes(frames: list[np.ndarray], truth: np.ndarray, boxes, refine: bool) -> float:
+    tracker = pftrack.Tracker(10.0, refine=refine, seed=0)
+    tracker.prime(frames[::2])
+    for k, frame in enumerate(frames, start=1):
+        tracker.update(xywh_to_xyxy_dets(boxes[k]), frame)
+    return float(evaluate_mot(truth, tracker.finalize()).mota)
+
+
+@pytest.mark.filterwarnings(GREY_WARNING)
+def test_grey_video_is_tracked_as_colour_from_the_same_boxes() -> None:
+    """Stop 67's split of the grey loss: given the colour video's own detector boxes (box
+    refinement off), the grey video is tracked as well as the colour one, so the trackers'
+    grey-only histograms (V bins alone) are not where the grey scene loses (0.880 both)."""
+    frames, truth = dark_clothes()
+    boxes = detector_boxes(frames)
+    colour = mota_of_boxes(frames, truth, boxes, refine=False)
+    grey = mota_of_boxes([to_grey(f) for f in frames], truth, boxes, refine=False)
+    assert colour > 0.8 and grey >= colour - 0.02, (colour, grey)
+
+
+@pytest.mark.filterwarnings(GREY_WARNING)
+@pytest.mark.xfail(
+    reason="known gap (stop 67): box refinement shrinks given boxes to the grey foreground, "
+    "which has fewer of the walkers' pixels than colour's (MOTA 0.70 against 0.86)",
+    strict=True,
+)
+def test_given_boxes_refined_on_grey_video_track_as_on_colour() -> None:
+    frames, truth = dark_clothes()
+    boxes = detector_boxes(frames)
+    colour = mota_of_boxes(frames, truth, boxes, refine=True)
+    grey = mota_of_boxes([to_grey(f) for f in frames], truth, boxes, refine=True)
+    assert grey >= colour - 0.05, (colour, grey)
+
+
+def grey_walker_found(config: PaperConfig, grey: bool) -> float:
+    """Share of a walker 20 levels brighter than the ground (in every channel) found as
+    foreground, by `config`'s detector, on the grey or the colour video."""
+    rng = np.random.default_rng(0)
+    # textured ground (a standard deviation of 15, so that the grey test can decide), tinted
+    # blue-red in colour; the walker is the ground brightened by 20 in every channel
+    base = rng.normal(120, 15, (120, 160, 1)) + np.array([10.0, 0.0, -10.0])
+    frames = []
+    for k in range(20):
+        f = base + rng.normal(0, 2, base.shape)
+        f[30:90, 10 + 3 * k : 30 + 3 * k] += 20.0
+        frame = np.clip(f, 0, 255).astype(np.uint8)
+        frames.append(to_grey(frame) if grey else frame)
+    det = PaperDetector(config)
+    det.prime(frames[::2])
+    assert det.grey == grey
+    return float(np.mean([(det.detect(f).mask[30:90] == 255).mean() for f in frames[5:]]))
+
+
+@pytest.mark.filterwarnings(GREY_WARNING)
+def test_grey_t_min_lowers_the_bound_of_grey_video_only() -> None:
+    """``PaperConfig.grey_t_min`` is the threshold's lower bound on grey video; colour video
+    keeps `t_min` (25 here: the walker's contrast of 20 is missed)."""
+    low = PaperConfig(grey_t_min=12.0)
+    assert grey_walker_found(PaperConfig(), grey=True) < 0.01  # 20 < 25: missed
+    assert grey_walker_found(low, grey=True) > 0.1  # 20 > 12: found
+    assert grey_walker_found(low, grey=False) < 0.01  # colour keeps t_min
+    det = PaperDetector(low)
+    assert det.model.t_min == 25.0  # before the video is seen
+    det.detect(to_grey(dark_walker(1)[0]))
+    assert det.model.t_min == 12.0 and det.model.shadow_lo == 1.0
 
 
 # gain_band=0: foreground almost everywhere, which the noise warning says
