@@ -1,4 +1,4 @@
-"""experiments.detector_robustness: its --hold-frames reaches the tracker."""
+"""experiments.detector_robustness: its --hold-frames and grey settings reach the tracker."""
 
 from __future__ import annotations
 
@@ -44,3 +44,40 @@ def test_bad_hold_frames_is_one_line(
         detector_robustness.main(["--sequences", "walkers", *args])
     assert e.value.code == 2
     assert message in capsys.readouterr().err
+
+
+def test_grey_settings_reach_the_detector_and_are_printed(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    seen: list[Any] = []
+    real = pftrack.tracking.track_frames
+
+    def first_frames(source: Any, config: Any, **kw: Any) -> Any:
+        seen.append(config.detector)
+        return real(source[:12], config=config, **kw)
+
+    monkeypatch.setattr(pftrack.tracking, "track_frames", first_frames)
+    args = ["--sequences", "walkers", "--variants", "ident", "--out", str(tmp_path)]
+    detector_robustness.main(args)
+    detector_robustness.main([*args, "--grey-t-min", "20", "--grey-shadow-lo", "0.8"])
+    assert seen[0] == "paper"  # unchanged unless asked
+    assert (seen[1].grey_t_min, seen[1].grey_shadow_lo, seen[1].t_min) == (20.0, 0.8, 25.0)
+    assert "detector=paper grey_t_min=20 grey_shadow_lo=0.8 " in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--grey-t-min", "70"], "grey_t_min is 70.0, expected None or in [0, t_max]"),
+        (["--grey-shadow-lo", "2"], "grey_shadow_lo is 2.0, expected in [0, 1]"),
+        (["--grey-t-min", "9", "--detector", "knn"], "--grey-t-min and --grey-shadow-lo need"),
+    ],
+)
+def test_bad_grey_settings_are_one_line(
+    args: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as e:
+        detector_robustness.main(["--sequences", "walkers", *args])
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
