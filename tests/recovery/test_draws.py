@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from pftrack._typing import F64
+from pftrack.recovery import calibrate
 from pftrack.recovery.calibrate import MATCH_DRAWS, _artificial_gaps, _flat, _region_blocks
 from tests.reference.calibrate import artificial_gaps
 
@@ -60,10 +61,15 @@ def _walks(rng: np.random.Generator, n: int, length: int) -> list[F64]:
     return runs
 
 
+@pytest.mark.parametrize("chunk", [1, 7, calibrate.DRAW_CHUNK])
 @pytest.mark.parametrize("seed", range(8))
-def test_artificial_gaps_with_regions_are_one_attempt_at_a_time(seed: int) -> None:
+def test_artificial_gaps_with_regions_are_one_attempt_at_a_time(
+    seed: int, chunk: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """With square regions, the gaps, their marks and the generator's state after them are
-    those of one draw per attempt (the reference), stretches running out included."""
+    those of one draw per attempt (the reference), stretches running out included, whatever
+    the attempts drawn at a time (a chunk ending before, at or after the n-th gap)."""
+    monkeypatch.setattr(calibrate, "DRAW_CHUNK", chunk)
     rng = np.random.default_rng(seed)
     runs = _walks(rng, int(rng.integers(3, 25)), 80)
     flat = _flat(runs)
@@ -72,7 +78,7 @@ def test_artificial_gaps_with_regions_are_one_attempt_at_a_time(seed: int) -> No
         (int(rng.integers(1, 30)), float(rng.exponential(6)), int(rng.integers(1, 14)), 4)
         for _ in range(int(rng.integers(1, 8)))
     ]
-    n = int(rng.integers(5, 120))
+    n = int(rng.integers(5, 400))
     got_rng, want_rng = np.random.default_rng([seed, 2]), np.random.default_rng([seed, 2])
     got_marks: list[bool] = []
     want_marks: list[bool] = []
@@ -118,3 +124,21 @@ def test_the_attempts_are_one_draw() -> None:
     assert all(np.array_equal(g[2], w[2]) for g, w in zip(got, want, strict=True))
     assert counting.bit_generator.state == want_rng.bit_generator.state
     assert counting.calls <= 2
+
+
+@pytest.mark.parametrize("n", [5, 40, 300, 700])
+def test_many_attempts_in_chunks_are_one_attempt_at_a_time(n: int) -> None:
+    """More attempts than a chunk (4 n past DRAW_CHUNK; few places, so most attempts repeat
+    one): the same gaps and state as the reference, in a few calls."""
+    runs = _walks(np.random.default_rng(n), 6, 40)
+    targets = [(4, 3.0, 3, 3), (9, 5.0, 2, 8), (200, 1.0, 3, 3)]  # 200: no run has room
+    counting = _Counting(np.random.default_rng([n, 5]))
+    want_rng = np.random.default_rng([n, 5])
+    got = _artificial_gaps(runs, targets, n, counting)  # type: ignore[arg-type]
+    want = artificial_gaps(runs, targets, n, want_rng)
+    assert len(got) == len(want) > 0
+    for g, w in zip(got, want, strict=True):
+        assert g[3] == w[3]
+        assert all(np.array_equal(a, b) for a, b in zip(g[:3], w[:3], strict=True))
+    assert counting.bit_generator.state == want_rng.bit_generator.state
+    assert counting.calls <= 2 * (4 * n // calibrate.DRAW_CHUNK + 1) + 1
