@@ -142,6 +142,10 @@ WINDOW_POINTS = max(RTS_HISTORY, WINDOW)
 #: gap at once: ``fill_gaps(rows, "auto")`` peaked at 1.2 KB a row of ``tracemalloc`` on 200 170
 #: rows with 39 830 holes (243 MB in ``recover_auto``: its copies 115, the neighbours' windows 130).
 RECOVER_BLOCK = 2048
+#: Attempts :func:`_artificial_gaps` draws at a time, at least (as many as gaps are still
+#: wanted when more): where places repeat, few chunks reach the gaps wanted (was one attempt
+#: per gap still wanted, a chunk each time: 62 draws for 60 gaps on PETS09-S2L1's region cuts).
+DRAW_CHUNK = 1024
 
 
 def bucket_of(length: int) -> int:
@@ -553,18 +557,35 @@ def _artificial_gaps(
     fits: dict[tuple[int, int, int], int] = {}  # the index in `fitting` of each key's
     fitting: list[tuple[NDArray[np.int64], NDArray[np.int64]]] = []
     order = rng.permutation(len(targets)) if len(targets) else np.zeros(0, dtype=np.int64)
+    # Each target's length, distance, contexts (n_a, n_b as given, ctx_a clipped), and where its
+    # places are (span -1 - k: the stretches of fitting[k]; else the span of the random places)
+    # with their number (0: none), worked out the first time an attempt takes the target.
+    tl, ta, tb, tc, tspan, tcount = (np.zeros(len(targets), dtype=np.int64) for _ in range(6))
+    td = np.zeros(len(targets), dtype=np.float64)
+    seen = np.zeros(len(targets), dtype=bool)
+    # The attempts (up to 4 n; the targets in turn) are drawn and matched a chunk at a time in a
+    # few array operations, then taken in turn until `n` gaps are cut: an attempt's draws do not
+    # depend on what the attempts before it gave, so they are those of one attempt at a time.
+    # One Generator.integers call draws a chunk's MATCH_DRAWS places per attempt, each bound
+    # repeated MATCH_DRAWS times: NumPy draws an array of bounds element by element as it draws
+    # one bound's `size` values (Lemire's rejection on 32 bits for a bound up to 2**32), so the
+    # integers are those of one call per attempt in turn (tests/recovery/test_draws.py; was a
+    # call per attempt). When the gaps are cut before a chunk's last attempt, the generator is
+    # set back and draws the chunk's attempts taken only: its state is theirs, as when the
+    # attempts stopped. A chunk is as many attempts as gaps are still wanted, at least
+    # DRAW_CHUNK (few calls where places repeat; memory bounded as one attempt per gap wanted).
     attempt, limit = 0, 4 * n if len(order) else 0
     while attempt < limit and len(out) < n:
-        # The next attempts are drawn, then their places matched in a few array operations:
-        # as many as gaps are still wanted, so the draws are those of one attempt at a time
-        # (an attempt gives one gap at most: none is drawn past the last one needed).
-        drawn: list[tuple[int, float, int, int, int, int, NDArray[np.int64]]] = []
-        for a in range(attempt, min(limit, attempt + n - len(out))):
-            t = targets[int(order[a % len(order)])]
+        stop = min(limit, attempt + max(n - len(out), DRAW_CHUNK))
+        tix = order[np.arange(attempt, stop) % len(order)]
+        attempt = stop
+        for i in np.unique(tix[~seen[tix]]).tolist():
+            t = targets[i]
             L, dist = int(t[0]), float(t[1])
             n_a, n_b = (int(t[2]), int(t[3])) if len(t) == 4 else (-1, -1)
             ctx_a = CONTEXT if n_a < 0 else min(max(n_a, CONTEXT), MAX_CONTEXT)
             ctx_b = CONTEXT if n_b < 0 else min(max(n_b, CONTEXT), MAX_CONTEXT)
+            tl[i], td[i], ta[i], tb[i], tc[i], seen[i] = L, dist, n_a, n_b, ctx_a, True
             if regions is not None:
                 key = (L, ctx_a, ctx_b)
                 if key not in fits:
@@ -575,52 +596,59 @@ def _artificial_gaps(
                     )
                     fits[key] = len(fitting)
                     fitting.append((regions.run[ok], regions.start[ok]))
-                if len(fitting[fits[key]][0]):  # span -1 - k: the stretches of fitting[k]
-                    ks = rng.integers(len(fitting[fits[key]][0]), size=MATCH_DRAWS)
-                    drawn.append((L, dist, n_a, n_b, ctx_a, -1 - fits[key], ks))
+                if len(fitting[fits[key]][0]):
+                    tspan[i], tcount[i] = -1 - fits[key], len(fitting[fits[key]][0])
                     continue
             span = L + ctx_a + ctx_b  # the places depend on it only: computed once per span
             if span not in places:
                 slots_of = np.maximum(sizes - span + 1, 0)
                 cum_of = np.cumsum(slots_of)
                 places[span] = (slots_of, cum_of, int(cum_of[-1]) if len(cum_of) else 0)
-            if places[span][2] == 0:
-                continue
-            ks = rng.integers(places[span][2], size=MATCH_DRAWS)
-            drawn.append((L, dist, n_a, n_b, ctx_a, span, ks))
-        attempt = min(limit, attempt + n - len(out))
-        if not drawn:
+            tspan[i], tcount[i] = span, places[span][2]
+        tix = tix[tcount[tix] > 0]  # an attempt without any place draws nothing
+        k = len(tix)
+        if not k:
             continue
-        k = len(drawn)
+        before = rng.bit_generator.state
+        draws = rng.integers(np.repeat(tcount[tix], MATCH_DRAWS)).reshape(k, MATCH_DRAWS)
         idx = np.zeros((k, MATCH_DRAWS), dtype=np.int64)
         starts = np.zeros((k, MATCH_DRAWS), dtype=np.int64)
-        spans = np.array([e[5] for e in drawn])
+        spans = tspan[tix]
         for span in set(spans.tolist()):  # each row as its own attempt computed it
             rows = np.flatnonzero(spans == span)
+            ks = draws[rows]
             if span < 0:  # a region's stretches: the run and start of each drawn entry
                 run_r, start_r = fitting[-1 - span]
-                ks = np.stack([drawn[r][6] for r in rows])
                 idx[rows], starts[rows] = run_r[ks], start_r[ks]
                 continue
             slots, cum, _ = places[span]
-            ks = np.stack([drawn[r][6] for r in rows])
             got = np.searchsorted(cum, ks, side="right")
             idx[rows] = got
-            ctx = np.array([drawn[r][4] for r in rows])[:, None]
-            starts[rows] = ctx + ks - (cum[got] - slots[got])
+            starts[rows] = tc[tix[rows]][:, None] + ks - (cum[got] - slots[got])
         # the draw whose end-point distance is nearest the target's (the first when no target)
         near = np.zeros(k, dtype=np.int64)
-        aim = np.flatnonzero(np.array([e[1] for e in drawn]) >= 0)
+        aim = np.flatnonzero(td[tix] >= 0)
         if len(aim):
-            L_of = np.array([drawn[r][0] for r in aim])[:, None]
+            L_of = tl[tix[aim]][:, None]
             at = offset[idx[aim]] + starts[aim]
             gap = xy[at + L_of] - xy[at - 1]  # (rows, MATCH_DRAWS, 2)
             d = np.round(np.hypot(gap[..., 0], gap[..., 1]), SPAN_DECIMALS)
-            log_dist = np.log1p(np.array([drawn[r][1] for r in aim]))[:, None]
+            log_dist = np.log1p(td[tix[aim]])[:, None]
             near[aim] = np.argmin(np.abs(np.log1p(d) - log_dist), axis=1)
-        for row, (L, _, n_a, n_b, _, _, _) in enumerate(drawn):
-            j = int(near[row])
-            i, st = int(idx[row, j]), int(starts[row, j])
+        chosen = zip(
+            tl[tix].tolist(),
+            ta[tix].tolist(),
+            tb[tix].tolist(),
+            idx[np.arange(k), near].tolist(),
+            starts[np.arange(k), near].tolist(),
+            (spans < 0).tolist(),
+            strict=True,
+        )
+        taken = k
+        for row, (L, n_a, n_b, i, st, by_region) in enumerate(chosen):
+            if len(out) >= n:
+                taken = row
+                break
             if (i, st, L) in used:
                 continue
             used.add((i, st, L))
@@ -629,7 +657,10 @@ def _artificial_gaps(
             hi = len(r) if n_b < 0 else st + L + n_b
             out.append((r[lo:st], r[st + L : hi], r[st : st + L], i))
             if marks is not None:
-                marks.append(int(spans[row]) < 0)
+                marks.append(by_region)
+        if taken < k:  # the attempts after the n-th gap were never made: their draws undone
+            rng.bit_generator.state = before
+            rng.integers(np.repeat(tcount[tix[:taken]], MATCH_DRAWS))
     if regions is not None and len(out) < n:
         # the regions' stretches ran out (each is used once): the rest at random places
         for seg_a, seg_b, lost, k in _artificial_gaps(runs, targets, 4 * (n - len(out)), rng, flat):
