@@ -579,7 +579,9 @@ def _artificial_gaps(
         stop = min(limit, attempt + max(n - len(out), DRAW_CHUNK))
         tix = order[np.arange(attempt, stop) % len(order)]
         attempt = stop
-        for i in np.unique(tix[~seen[tix]]).tolist():
+        # sorted(set()), not np.unique: NumPy 2.4's unique imports numpy.ma (0.1 s), which
+        # `pftrack recover` never needs (tests/test_stats.py)
+        for i in sorted(set(tix[~seen[tix]].tolist())):
             t = targets[i]
             L, dist = int(t[0]), float(t[1])
             n_a, n_b = (int(t[2]), int(t[3])) if len(t) == 4 else (-1, -1)
