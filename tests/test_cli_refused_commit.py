@@ -547,3 +547,67 @@ def test_a_ctrl_c_inside_importlib_is_raised_on_the_next_line_outside_it() -> No
             _on_sigint(signal.SIGINT, sys._getframe())
     finally:
         signal.signal(signal.SIGINT, before)
+
+
+def test_a_sigterm_inside_importlib_is_raised_on_the_next_line_outside_it() -> None:
+    """The command's SIGTERM handler (``pftrack.cli._signals``, set while a command runs) did
+    what the console's SIGINT handler did before 3a412e73: it raised ``Terminated`` inside
+    importlib's frozen frames, where C that imports (a late ``import cv2`` in a command's
+    body) prints it as a traceback. Now it raises the signal again, and the next line outside
+    them raises it; its handler is not yet set to ignore (that is the raise's)."""
+    import signal
+    import sys
+    import types
+
+    from pftrack.cli._signals import Terminated, _raise_terminated
+
+    inside = types.SimpleNamespace(f_code=compile("pass", "<frozen importlib._bootstrap>", "exec"))
+    seen: list[int] = []
+    before = signal.signal(signal.SIGTERM, lambda signum, frame: seen.append(signum))
+    try:
+        try:
+            _raise_terminated(signal.SIGTERM, inside)
+        except Terminated:
+            pytest.fail("raised inside importlib's frames")  # was: raised here
+        for _ in range(1000):  # Python runs the handler between bytecodes
+            pass
+        assert seen == [signal.SIGTERM]  # raised again, for the next line
+        signal.signal(signal.SIGTERM, _raise_terminated)
+        with pytest.raises(Terminated):
+            _raise_terminated(signal.SIGTERM, inside)
+            for _ in range(1000):
+                pass
+            pytest.fail("the SIGTERM put off was never raised")
+        assert signal.getsignal(signal.SIGTERM) == signal.SIG_IGN  # once, as ever
+        signal.signal(signal.SIGTERM, _raise_terminated)
+        with pytest.raises(Terminated):  # anywhere else: at once
+            _raise_terminated(signal.SIGTERM, sys._getframe())
+    finally:
+        signal.signal(signal.SIGTERM, before)
+
+
+def test_a_second_ctrl_c_of_a_stopping_track_inside_importlib_waits_for_the_next_line() -> None:
+    """``pftrack track``'s live handler: a second Ctrl-C aborts with ``KeyboardInterrupt``;
+    inside importlib's frames it is raised again instead, as the console's handler does."""
+    import signal
+    import sys
+    import types
+
+    from pftrack.cli.track import _StopOnCtrlC
+
+    inside = types.SimpleNamespace(f_code=compile("pass", "<frozen importlib._bootstrap>", "exec"))
+    seen: list[int] = []
+    stopping = _StopOnCtrlC(types.SimpleNamespace(stopped=True))
+    before = signal.signal(signal.SIGINT, lambda signum, frame: seen.append(signum))
+    try:
+        try:
+            stopping._handler(signal.SIGINT, inside)
+        except KeyboardInterrupt:
+            pytest.fail("raised inside importlib's frames")  # was: raised here
+        for _ in range(1000):
+            pass
+        assert seen == [signal.SIGINT]
+        with pytest.raises(KeyboardInterrupt):  # anywhere else: at once
+            stopping._handler(signal.SIGINT, sys._getframe())
+    finally:
+        signal.signal(signal.SIGINT, before)

@@ -123,6 +123,12 @@ class _StopOnCtrlC:
 
     def _handler(self, signum: int, frame: Any) -> None:
         if self.source.stopped:
+            from pftrack.cli._signals import in_import_machinery
+
+            if in_import_machinery(frame):  # raised at the next line outside importlib's
+                # frames (raised into C that imports, it was printed as a traceback)
+                signal.raise_signal(signal.SIGINT)
+                return
             # the abort, once: a third Ctrl-C raised in its cleanup could skip the wait for the
             # source's reader threads, and the process aborted at exit with a thread inside a
             # C++ read ("FATAL: exception not rethrown"); __exit__ restores the handler
