@@ -44,6 +44,20 @@ def _flag_cleared() -> Iterator[None]:
     _interrupt.clear()
 
 
+def _write_earlier(path: Path) -> None:
+    """An earlier run's output at `path`: text, or for a video an earlier pftrack render (pftrack
+    replaces no other video)."""
+    if path.suffix != ".mp4":
+        path.write_bytes(EARLIER)
+        return
+    import numpy as np
+
+    from pftrack.io.video_writer import VideoWriter
+
+    with VideoWriter(path, fps=5) as writer:
+        writer.write(np.zeros((16, 16, 3), np.uint8))
+
+
 def _snapshot(folder: Path) -> dict[str, bytes | None]:
     return {p.name: (p.read_bytes() if p.is_file() else None) for p in folder.iterdir()}
 
@@ -102,13 +116,14 @@ def test_a_lost_ctrl_c_changes_no_output(
     assert main(["-q", *argv(inputs, out)]) == 0, capsys.readouterr().err  # the command works
     assert sorted(p.name for p in out.iterdir()) == sorted(names)
     for name in names:
-        (out / name).write_bytes(EARLIER)
+        _write_earlier(out / name)
+    earlier = _snapshot(out)
     capsys.readouterr()
     for folder in (out, fresh):
         _interrupt.remember()  # as the handler does; its KeyboardInterrupt dropped by code in C
         assert main(["-q", *argv(inputs, folder)]) == 130
         assert capsys.readouterr().err == _said(command)
-    assert _snapshot(out) == dict.fromkeys(names, EARLIER)  # and no temporary file
+    assert _snapshot(out) == earlier  # and no temporary file
     assert list(fresh.iterdir()) == []
 
 
@@ -326,7 +341,8 @@ def test_a_signal_between_the_renames_leaves_every_output_new(
 
     names, argv = COMMANDS[command]
     for name in names:
-        (tmp_path / name).write_bytes(EARLIER)
+        _write_earlier(tmp_path / name)
+    earlier = _snapshot(tmp_path)
     renamed = _signal_after_renaming(
         monkeypatch, getattr(signal, signame), {tmp_path / n for n in names}
     )
@@ -335,7 +351,7 @@ def test_a_signal_between_the_renames_leaves_every_output_new(
     assert sorted(renamed) == sorted(names)
     snapshot = _snapshot(tmp_path)
     assert sorted(snapshot) == sorted(names)  # no temporary file
-    assert all(snapshot[name] != EARLIER for name in names)
+    assert all(snapshot[name] != earlier[name] for name in names)
 
 
 @pytest.mark.filterwarnings("ignore:no track over 5 frames")  # 5 frames: no track confirmed
@@ -456,8 +472,9 @@ def test_track_whose_second_rename_fails_puts_the_first_output_back(
 
     out, video = tmp_path / "t.txt", tmp_path / "v.mp4"
     for path in (out, video):
-        path.write_bytes(EARLIER)
+        _write_earlier(path)
         path.chmod(0o600)
+    earlier = _snapshot(tmp_path)
     stale = tmp_path / ".t.txt.0123456789ab.old"
     stale.write_bytes(b"older")
     renamed = _folder_at_the_second_rename(monkeypatch, {out, video})
@@ -466,7 +483,8 @@ def test_track_whose_second_rename_fails_puts_the_first_output_back(
     assert main(argv) == 2
     monkeypatch.undo()
     first, second = (tmp_path / n for n in renamed[:2])
-    assert first.read_bytes() == EARLIER and stat.S_IMODE(os.stat(first).st_mode) == 0o600
+    assert first.read_bytes() == earlier[first.name]
+    assert stat.S_IMODE(os.stat(first).st_mode) == 0o600
     assert capsys.readouterr().err == (
         f"pftrack track: error: cannot replace output {second} (Is a directory); no output file "
         "was changed\n"

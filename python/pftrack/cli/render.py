@@ -89,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
         is_live_source,
         source_files,
     )
-    from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size
+    from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size, is_render
     from pftrack.recovery.linking import read_tracks
     from pftrack.render import paths_title, plot_trajectories, write_annotated_video
 
@@ -101,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"{args.source} is a live source: render reads a video file or folder")
     check_input_file(args.tracks, what="tracks file")
     inputs = (*source_files(args.source), args.tracks)
-    check_output(args.out, what="--out", suffixes=VIDEO_SUFFIXES, inputs=inputs)
+    check_output(args.out, what="--out", suffixes=VIDEO_SUFFIXES, inputs=inputs, ours=is_render)
     if args.plot is not None:  # "" too: refused as empty (was: no plot, without a word)
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     check_distinct({"--out": args.out, "--plot": args.plot})

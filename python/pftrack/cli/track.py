@@ -240,7 +240,7 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     from pftrack.cli._options import check_input_file
     from pftrack.io.atomic import check_distinct, check_output
     from pftrack.io.video import check_outside_frames, find_sequence, source_files
-    from pftrack.io.video_writer import VIDEO_SUFFIXES
+    from pftrack.io.video_writer import VIDEO_SUFFIXES, is_render
 
     given = [d for d in (args.detections,) if d and d != "auto"]
     for det in given:
@@ -254,7 +254,9 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
             inputs += (found,) if found is not None else ()
     check_output(args.out, what="--out", inputs=inputs, tracks=True)
     if args.render is not None:  # "" too: refused as empty (was: no video, without a word)
-        check_output(args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs)
+        check_output(
+            args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs, ours=is_render
+        )
     if args.plot is not None:
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     outputs = {"--out": args.out, "--render": args.render, "--plot": args.plot}
