@@ -72,3 +72,37 @@ def test_frames_a_decoder_dropped_are_said_once_naming_the_file(
 def test_an_intact_h264_file_says_nothing(tmp_path: Path) -> None:
     frames, said = _read(_h264(tmp_path / "intact.mp4", zeroed=None))
     assert len(frames) == 60 and said == []
+
+
+def test_a_frame_that_fails_after_a_dropped_one_is_read_past(tmp_path: Path) -> None:
+    """The stamps jumped where the decoder dropped frames, and the reader stopped resuming: a
+    later frame that failed to decode ended the run there (stop 66's ``flip_h.mp4``: 18 of 50
+    frames). Now the stamps are counted from the jump on, and the reader goes on past the
+    failure as in an undamaged stream, the frame before standing in; the count agrees."""
+    import cv2
+
+    dropped = _h264(tmp_path / "dropped.mp4", zeroed=25).read_bytes()
+    n = len(dropped)
+    for seed in range(40):  # bytes flipped late in the file until a read there fails
+        rng = np.random.default_rng(seed)
+        damaged = bytearray(dropped)
+        for i in rng.integers(int(n * 0.7), int(n * 0.95), 60):
+            damaged[i] ^= 0xFF
+        path = tmp_path / f"flipped{seed}.mp4"
+        path.write_bytes(bytes(damaged))
+        capture = cv2.VideoCapture(str(path))
+        reads = [capture.read()[0] for _ in range(62)]
+        capture.release()
+        if False in reads[:48] and any(reads[reads.index(False) :]):
+            break
+    else:
+        pytest.skip("no flip made a read fail with frames after it (another FFmpeg?)")
+    failed = reads.index(False)
+    frames, said = _read(path)
+    assert len(frames) > failed + 1  # was: len(frames) == failed, the run ended there
+    assert len(frames) >= sum(reads)  # every frame that decodes, and stand-ins
+    assert any("could not be decoded" in m for m in said)
+    assert any(SKIPPED in m for m in said)
+    with pytest.warns(UserWarning, match="its header says 60 frames but it holds"):
+        counted = FrameSource(path).recount()
+    assert counted == len(frames)  # the count before a run agrees

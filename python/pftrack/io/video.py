@@ -2344,6 +2344,8 @@ class FrameSource:
                         stamp = _stamp_index(cap, rate)
                         if found == 0:
                             start = stamp
+                        elif stamp - start > found:  # frames a decoder dropped without
+                            start = stamp - found  # failing (H.264): counted on, as read
                         elif stamp - start != found:
                             timed = False  # not a constant-rate file: no resuming
                     found += 1
@@ -2680,9 +2682,14 @@ class FrameSource:
                         start = stamp
                         if start > 0:
                             self._warn_cut_start(start, float(cap.get(cv2.CAP_PROP_POS_MSEC)))
+                    elif stamp - start > decoded:  # frames a decoder dropped without failing
+                        # (H.264): numbered by counting, as ever, and the stamps counted from
+                        # here, so that a later frame that fails is read on past (recount
+                        # alike); was: no resuming, the run ended there (stop 66's flip_h.mp4)
+                        skip = skip or (decoded, stamp - start)
+                        start = stamp - decoded
                     elif stamp - start != decoded:
                         timed = False  # not a constant-rate file: no resuming after damage
-                        skip = (decoded, stamp - start)  # or frames a decoder dropped
                 if not ok:
                     if not timed or decoded >= self.n_frames:
                         break
