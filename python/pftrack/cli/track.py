@@ -238,7 +238,7 @@ def _det_scale(args: argparse.Namespace, source: Any, det_path: str, said: list[
 def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     """Before any work: the detection file can be read, every output written, none twice."""
     from pftrack.cli._options import check_input_file
-    from pftrack.io.atomic import check_distinct, check_output
+    from pftrack.io.atomic import check_distinct, check_output, check_replaceable
     from pftrack.io.video import check_outside_frames, find_sequence, source_files
     from pftrack.io.video_writer import VIDEO_SUFFIXES, is_render
 
@@ -254,13 +254,13 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
             inputs += (found,) if found is not None else ()
     check_output(args.out, what="--out", inputs=inputs, tracks=True)
     if args.render is not None:  # "" too: refused as empty (was: no video, without a word)
-        check_output(
-            args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs, ours=is_render
-        )
+        check_output(args.render, what="--render", suffixes=VIDEO_SUFFIXES, inputs=inputs)
     if args.plot is not None:
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     outputs = {"--out": args.out, "--render": args.render, "--plot": args.plot}
     check_distinct(outputs)
+    if args.render:
+        check_replaceable(args.render, "--render", is_render)
     if not live:
         check_outside_frames(outputs, args.source)
 

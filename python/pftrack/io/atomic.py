@@ -795,7 +795,6 @@ def check_output(
     inputs: tuple[PathLike, ...] = (),
     within: PathLike | None = None,
     tracks: bool = False,
-    ours: Callable[[Path], bool] | None = None,
 ) -> Path:
     """Check, before any work, that `path` can be written; return it as a :class:`Path`.
 
@@ -819,17 +818,12 @@ def check_output(
         first 8 KiB: a video, a picture) is then refused, so that ``--out annotated.mp4``
         typed for ``--render annotated.mp4`` does not replace the video with text (was:
         replaced without a word). A text file is replaced, as any output is.
-    ours : callable, optional
-        Whether an existing file at `path` is one pftrack wrote there
-        (:func:`pftrack.io.video_writer.is_render` for a video): any other non-empty file is
-        then refused, a user's video kept (was: replaced, exit status 0).
 
     Raises
     ------
     ValueError
         The path is empty; the extension is not supported; for a tracks file (`tracks`), an
-        existing file that is not text; for `ours`, an existing file it says pftrack did not
-        write; the path is a folder, or can only
+        existing file that is not text; the path is a folder, or can only
         name one (a trailing slash: ``newdir/``); it is ``-`` (standard output: give
         ``/dev/stdout``); or it names an input.
     FileNotFoundError
@@ -878,19 +872,30 @@ def check_output(
         raise ValueError(f"{what} {target} is an input of this run; write elsewhere")
     if tracks and not resolved.through:
         _refuse_binary(written, what, text)
-    if ours is not None and not resolved.through:
-        _refuse_foreign(written, what, text, ours)
     return target
 
 
-def _refuse_foreign(written: Path, what: str, text: str, ours: Callable[[Path], bool]) -> None:
-    """Refuse to replace an existing non-empty file that `ours` says pftrack did not write."""
+def check_replaceable(path: PathLike, what: str, ours: Callable[[Path], bool]) -> None:
+    """Refuse to replace a non-empty file at `path` that `ours` says pftrack did not write.
+
+    `ours`: :func:`pftrack.io.video_writer.is_render` for a video output. Called after
+    :func:`check_output` and :func:`check_distinct`, whose messages say more.
+
+    Raises
+    ------
+    ValueError
+        Such a file, naming `what` (was: a user's video replaced, exit status 0).
+    """
+    text = os.fsdecode(os.fspath(path))
+    written = _resolve(text)
+    if written.through:
+        return
     try:
-        if not written.is_file() or written.stat().st_size == 0:
+        if not written.path.is_file() or written.path.stat().st_size == 0:
             return  # nothing there to lose
     except OSError:  # unreadable: the write says so
         return
-    if not ours(written):
+    if not ours(written.path):
         raise ValueError(
             f"{what} {text} is an existing file that pftrack did not write (a video of yours?), "
             "and would be replaced: move it, or give another name"
