@@ -20,6 +20,7 @@ import pytest
 
 from pftrack.cli import main
 from pftrack.io.mot import write_mot
+from pftrack.io.video_writer import VideoWriter
 from pftrack.synthetic import make_scene
 
 ROOT = os.geteuid() == 0 if hasattr(os, "geteuid") else False
@@ -459,8 +460,10 @@ def test_interrupted_track_run_changes_no_output(
     import pftrack.tracking as tracking
 
     out, video, plot = tmp_path / "t.txt", tmp_path / "v.mp4", tmp_path / "p.png"
-    for p in (out, video, plot):
+    for p in (out, plot):
         p.write_bytes(b"good result of an earlier run\n")
+    with VideoWriter(video, fps=5) as writer:  # an earlier render: pftrack replaces no other
+        writer.write(np.zeros((16, 16, 3), np.uint8))
     real_track = tracking.track_frames
 
     def interrupt_after_writing(path: Any, *args: Any, **kwargs: Any) -> None:
@@ -661,6 +664,8 @@ def test_outputs_through_symlinks_replace_the_target_and_keep_the_link(
     for name in ("t.txt", "v.mp4", "r.txt", "in.txt"):
         (real / name).write_text("old\n")
         (tmp_path / name).symlink_to(Path("real") / name)
+    with VideoWriter(real / "v.mp4", fps=5) as writer:  # an earlier render: pftrack's own
+        writer.write(np.zeros((16, 16, 3), np.uint8))
     (real / "in.txt").write_bytes(inputs["tracks"].read_bytes())
     argv = ["-q", "track", str(inputs["video"]), "--out", str(tmp_path / "t.txt"),
             "--render", str(tmp_path / "v.mp4"), "--particles", "20"]  # fmt: skip
@@ -869,6 +874,8 @@ def test_sigterm_is_handled_as_ctrl_c(tmp_path: Path) -> None:
     out.mkdir()
     for name in ("t.txt", "t.mp4"):
         (out / name).write_bytes(b"an earlier result\n")
+    with VideoWriter(out / "t.mp4", fps=5) as writer:  # an earlier render: pftrack's own
+        writer.write(np.zeros((16, 16, 3), np.uint8))
     before = _snapshot(out)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     argv = [sys.executable, "-m", "pftrack", "-q", "track", str(video), "--out", "t.txt",

@@ -44,6 +44,20 @@ def _flag_cleared() -> Iterator[None]:
     _interrupt.clear()
 
 
+def _write_earlier(path: Path) -> None:
+    """An earlier run's output at `path`: text, or for a video an earlier pftrack render (pftrack
+    replaces no other video)."""
+    if path.suffix != ".mp4":
+        path.write_bytes(EARLIER)
+        return
+    import numpy as np
+
+    from pftrack.io.video_writer import VideoWriter
+
+    with VideoWriter(path, fps=5) as writer:
+        writer.write(np.zeros((16, 16, 3), np.uint8))
+
+
 def _snapshot(folder: Path) -> dict[str, bytes | None]:
     return {p.name: (p.read_bytes() if p.is_file() else None) for p in folder.iterdir()}
 
@@ -102,13 +116,14 @@ def test_a_lost_ctrl_c_changes_no_output(
     assert main(["-q", *argv(inputs, out)]) == 0, capsys.readouterr().err  # the command works
     assert sorted(p.name for p in out.iterdir()) == sorted(names)
     for name in names:
-        (out / name).write_bytes(EARLIER)
+        _write_earlier(out / name)
+    earlier = _snapshot(out)
     capsys.readouterr()
     for folder in (out, fresh):
         _interrupt.remember()  # as the handler does; its KeyboardInterrupt dropped by code in C
         assert main(["-q", *argv(inputs, folder)]) == 130
         assert capsys.readouterr().err == _said(command)
-    assert _snapshot(out) == dict.fromkeys(names, EARLIER)  # and no temporary file
+    assert _snapshot(out) == earlier  # and no temporary file
     assert list(fresh.iterdir()) == []
 
 
@@ -326,7 +341,8 @@ def test_a_signal_between_the_renames_leaves_every_output_new(
 
     names, argv = COMMANDS[command]
     for name in names:
-        (tmp_path / name).write_bytes(EARLIER)
+        _write_earlier(tmp_path / name)
+    earlier = _snapshot(tmp_path)
     renamed = _signal_after_renaming(
         monkeypatch, getattr(signal, signame), {tmp_path / n for n in names}
     )
@@ -335,7 +351,7 @@ def test_a_signal_between_the_renames_leaves_every_output_new(
     assert sorted(renamed) == sorted(names)
     snapshot = _snapshot(tmp_path)
     assert sorted(snapshot) == sorted(names)  # no temporary file
-    assert all(snapshot[name] != EARLIER for name in names)
+    assert all(snapshot[name] != earlier[name] for name in names)
 
 
 @pytest.mark.filterwarnings("ignore:no track over 5 frames")  # 5 frames: no track confirmed
@@ -456,8 +472,9 @@ def test_track_whose_second_rename_fails_puts_the_first_output_back(
 
     out, video = tmp_path / "t.txt", tmp_path / "v.mp4"
     for path in (out, video):
-        path.write_bytes(EARLIER)
+        _write_earlier(path)
         path.chmod(0o600)
+    earlier = _snapshot(tmp_path)
     stale = tmp_path / ".t.txt.0123456789ab.old"
     stale.write_bytes(b"older")
     renamed = _folder_at_the_second_rename(monkeypatch, {out, video})
@@ -466,7 +483,8 @@ def test_track_whose_second_rename_fails_puts_the_first_output_back(
     assert main(argv) == 2
     monkeypatch.undo()
     first, second = (tmp_path / n for n in renamed[:2])
-    assert first.read_bytes() == EARLIER and stat.S_IMODE(os.stat(first).st_mode) == 0o600
+    assert first.read_bytes() == earlier[first.name]
+    assert stat.S_IMODE(os.stat(first).st_mode) == 0o600
     assert capsys.readouterr().err == (
         f"pftrack track: error: cannot replace output {second} (Is a directory); no output file "
         "was changed\n"
@@ -545,5 +563,69 @@ def test_a_ctrl_c_inside_importlib_is_raised_on_the_next_line_outside_it() -> No
             pytest.fail("the interrupt put off was never raised")
         with pytest.raises(KeyboardInterrupt):  # anywhere else: at once
             _on_sigint(signal.SIGINT, sys._getframe())
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+def test_a_sigterm_inside_importlib_is_raised_on_the_next_line_outside_it() -> None:
+    """The command's SIGTERM handler (``pftrack.cli._signals``, set while a command runs) did
+    what the console's SIGINT handler did before 3a412e73: it raised ``Terminated`` inside
+    importlib's frozen frames, where C that imports (a late ``import cv2`` in a command's
+    body) prints it as a traceback. Now it raises the signal again, and the next line outside
+    them raises it; its handler is not yet set to ignore (that is the raise's)."""
+    import signal
+    import sys
+    import types
+
+    from pftrack.cli._signals import Terminated, _raise_terminated
+
+    inside = types.SimpleNamespace(f_code=compile("pass", "<frozen importlib._bootstrap>", "exec"))
+    seen: list[int] = []
+    before = signal.signal(signal.SIGTERM, lambda signum, frame: seen.append(signum))
+    try:
+        try:
+            _raise_terminated(signal.SIGTERM, inside)
+        except Terminated:
+            pytest.fail("raised inside importlib's frames")  # was: raised here
+        for _ in range(1000):  # Python runs the handler between bytecodes
+            pass
+        assert seen == [signal.SIGTERM]  # raised again, for the next line
+        signal.signal(signal.SIGTERM, _raise_terminated)
+        with pytest.raises(Terminated):
+            _raise_terminated(signal.SIGTERM, inside)
+            for _ in range(1000):
+                pass
+            pytest.fail("the SIGTERM put off was never raised")
+        assert signal.getsignal(signal.SIGTERM) == signal.SIG_IGN  # once, as ever
+        signal.signal(signal.SIGTERM, _raise_terminated)
+        with pytest.raises(Terminated):  # anywhere else: at once
+            _raise_terminated(signal.SIGTERM, sys._getframe())
+    finally:
+        signal.signal(signal.SIGTERM, before)
+
+
+def test_a_second_ctrl_c_of_a_stopping_track_inside_importlib_waits_for_the_next_line() -> None:
+    """``pftrack track``'s live handler: a second Ctrl-C aborts with ``KeyboardInterrupt``;
+    inside importlib's frames it is raised again instead, as the console's handler does."""
+    import signal
+    import sys
+    import types
+
+    from pftrack.cli.track import _StopOnCtrlC
+
+    inside = types.SimpleNamespace(f_code=compile("pass", "<frozen importlib._bootstrap>", "exec"))
+    seen: list[int] = []
+    stopping = _StopOnCtrlC(types.SimpleNamespace(stopped=True))
+    before = signal.signal(signal.SIGINT, lambda signum, frame: seen.append(signum))
+    try:
+        try:
+            stopping._handler(signal.SIGINT, inside)
+        except KeyboardInterrupt:
+            pytest.fail("raised inside importlib's frames")  # was: raised here
+        for _ in range(1000):
+            pass
+        assert seen == [signal.SIGINT]
+        with pytest.raises(KeyboardInterrupt):  # anywhere else: at once
+            stopping._handler(signal.SIGINT, sys._getframe())
     finally:
         signal.signal(signal.SIGINT, before)

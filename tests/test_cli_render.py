@@ -10,6 +10,7 @@ import pytest
 from pftrack.cli import main
 from pftrack.io.mot import read_mot, write_mot
 from pftrack.io.video import FrameSource
+from pftrack.io.video_writer import VideoWriter
 from pftrack.render import write_annotated_video
 from pftrack.synthetic import Scene, make_scene
 from tests.io.decode import decode
@@ -85,7 +86,9 @@ def test_bad_input_is_one_line_and_nothing_is_lost(
 ) -> None:
     _, video, truth = scene_files
     kept = tmp_path / "kept.mp4"
-    kept.write_bytes(b"earlier")
+    with VideoWriter(kept, fps=5) as writer:  # an earlier render: pftrack replaces no other
+        writer.write(np.zeros((16, 16, 3), np.uint8))
+    earlier = kept.read_bytes()
 
     def error(*argv: str) -> str:
         assert main(["render", *argv]) == 2
@@ -109,7 +112,7 @@ def test_bad_input_is_one_line_and_nothing_is_lost(
     assert "negative" in error(str(video), str(bad), "--out", str(kept))
     before = video.read_bytes()
     assert "is an input" in error(str(video), str(truth), "--out", str(video))  # never the input
-    assert kept.read_bytes() == b"earlier" and video.read_bytes() == before
+    assert kept.read_bytes() == earlier and video.read_bytes() == before
 
 
 @pytest.mark.parametrize(

@@ -19,6 +19,7 @@ import threading
 from collections.abc import Iterator
 from typing import Any
 
+from pftrack._console import IMPORT_MACHINERY
 from pftrack._interrupt import Terminated
 
 __all__ = [
@@ -76,6 +77,11 @@ def line_end() -> str:
 
 
 def _raise_terminated(signum: int, frame: Any) -> None:
+    if in_import_machinery(frame):  # put off to the next line outside importlib's frames, as
+        # the console's SIGINT handler does (pftrack._console._on_sigint): raised into C that
+        # imports (an extension's init importing NumPy), Terminated was printed as a traceback
+        signal.raise_signal(signal.SIGTERM)  # this handler, still set, runs at the next line
+        return
     # once: the command is unwinding (its writers removing their temporary files, its reader
     # threads stopping), and a second SIGTERM raised in that cleanup left a reader thread
     # inside a C++ read as the process exited, which aborted or crashed it ("FATAL: exception
@@ -83,6 +89,18 @@ def _raise_terminated(signum: int, frame: Any) -> None:
     # its process group. sigterm_raises restores the handler when the command ends.
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     raise Terminated
+
+
+def in_import_machinery(frame: Any) -> bool:
+    """Whether a signal handler's `frame` is one of importlib's own (frozen) frames.
+
+    An exception a handler raises there may be raised into C that imports and prints it (a
+    traceback, then that import's own error): a late import (``import cv2`` in a command's
+    body) at the moment of a Ctrl-C or a SIGTERM. Such a handler sends its signal again and
+    returns; it runs again at the next line, outside them once the import's frames return.
+    """
+    code = getattr(frame, "f_code", None)
+    return code is not None and code.co_filename.startswith(IMPORT_MACHINERY)
 
 
 #: Set by the ``pftrack`` console script (:mod:`pftrack._console`): the process ends with the

@@ -81,7 +81,13 @@ def run(args: argparse.Namespace) -> int:
     from pftrack._text import on_one_line as _shown  # a name's bytes not UTF-8 as \xe9, as errors
     from pftrack.cli._options import opencv_single_threaded
     from pftrack.cli._signals import hold_interrupts
-    from pftrack.io.atomic import check_distinct, check_output, output_format, staged_outputs
+    from pftrack.io.atomic import (
+        check_distinct,
+        check_output,
+        check_replaceable,
+        output_format,
+        staged_outputs,
+    )
     from pftrack.io.video import (
         FrameSource,
         check_outside_frames,
@@ -89,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
         is_live_source,
         source_files,
     )
-    from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size
+    from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size, is_render
     from pftrack.recovery.linking import read_tracks
     from pftrack.render import paths_title, plot_trajectories, write_annotated_video
 
@@ -105,6 +111,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plot is not None:  # "" too: refused as empty (was: no plot, without a word)
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     check_distinct({"--out": args.out, "--plot": args.plot})
+    check_replaceable(args.out, "--out", is_render)
     check_outside_frames({"--out": args.out, "--plot": args.plot}, args.source)
     rows = read_tracks(args.tracks, tracks_only=False)  # id -1 rows drawn, as any other
     rows[:, 2:6] *= args.scale

@@ -123,6 +123,12 @@ class _StopOnCtrlC:
 
     def _handler(self, signum: int, frame: Any) -> None:
         if self.source.stopped:
+            from pftrack.cli._signals import in_import_machinery
+
+            if in_import_machinery(frame):  # raised at the next line outside importlib's
+                # frames (raised into C that imports, it was printed as a traceback)
+                signal.raise_signal(signal.SIGINT)
+                return
             # the abort, once: a third Ctrl-C raised in its cleanup could skip the wait for the
             # source's reader threads, and the process aborted at exit with a thread inside a
             # C++ read ("FATAL: exception not rethrown"); __exit__ restores the handler
@@ -232,9 +238,9 @@ def _det_scale(args: argparse.Namespace, source: Any, det_path: str, said: list[
 def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     """Before any work: the detection file can be read, every output written, none twice."""
     from pftrack.cli._options import check_input_file
-    from pftrack.io.atomic import check_distinct, check_output
+    from pftrack.io.atomic import check_distinct, check_output, check_replaceable
     from pftrack.io.video import check_outside_frames, find_sequence, source_files
-    from pftrack.io.video_writer import VIDEO_SUFFIXES
+    from pftrack.io.video_writer import VIDEO_SUFFIXES, is_render
 
     given = [d for d in (args.detections,) if d and d != "auto"]
     for det in given:
@@ -253,6 +259,8 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     outputs = {"--out": args.out, "--render": args.render, "--plot": args.plot}
     check_distinct(outputs)
+    if args.render:
+        check_replaceable(args.render, "--render", is_render)
     if not live:
         check_outside_frames(outputs, args.source)
 

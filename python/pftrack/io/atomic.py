@@ -875,6 +875,33 @@ def check_output(
     return target
 
 
+def check_replaceable(path: PathLike, what: str, ours: Callable[[Path], bool]) -> None:
+    """Refuse to replace a non-empty file at `path` that `ours` says pftrack did not write.
+
+    `ours`: :func:`pftrack.io.video_writer.is_render` for a video output. Called after
+    :func:`check_output` and :func:`check_distinct`, whose messages say more.
+
+    Raises
+    ------
+    ValueError
+        Such a file, naming `what` (was: a user's video replaced, exit status 0).
+    """
+    text = os.fsdecode(os.fspath(path))
+    written = _resolve(text)
+    if written.through:
+        return
+    try:
+        if not written.path.is_file() or written.path.stat().st_size == 0:
+            return  # nothing there to lose
+    except OSError:  # unreadable: the write says so
+        return
+    if not ours(written.path):
+        raise ValueError(
+            f"{what} {text} is an existing file that pftrack did not write (a video of yours?), "
+            "and would be replaced: move it, or give another name"
+        )
+
+
 def _refuse_binary(written: Path, what: str, text: str) -> None:
     """Refuse to replace an existing file that is not text with tracks (:func:`check_output`)."""
     try:

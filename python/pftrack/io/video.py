@@ -1940,6 +1940,8 @@ class FrameSource:
         self._decoder_said: set[str] = set()  # what image decoders printed: each said once
         self._warned_short = False  # a video's frames were not its header's or seqLength's
         self._warned_uneven = False  # a video's time stamps were looked at (_warn_uneven)
+        self._warned_skip = False  # its stamps skipped frames a decoder dropped (_warn_skip)
+        self._header_frames = 0  # the header's frame count, if it has one (set when opened)
         # the frames inside the video said not to decode (_warn_lost): said between frames
         # once, at the end of a pass again only for more
         self._said_lost: frozenset[int] = frozenset()
@@ -2014,6 +2016,7 @@ class FrameSource:
             self.path is not None
             and (self.path.is_dir() or self.path.suffix.lower() in COUNTED_SUFFIXES)
         )
+        self._header_frames = self.counted_frames  # kept when a count replaces it (_warn_skip)
         seq_fps = self.sequence.frame_rate if self.sequence is not None else None
         if fps is not None:
             self.fps, self.fps_origin = float(fps), "given"
@@ -2341,6 +2344,8 @@ class FrameSource:
                         stamp = _stamp_index(cap, rate)
                         if found == 0:
                             start = stamp
+                        elif stamp - start > found:  # frames a decoder dropped without
+                            start = stamp - found  # failing (H.264): counted on, as read
                         elif stamp - start != found:
                             timed = False  # not a constant-rate file: no resuming
                     found += 1
@@ -2660,6 +2665,7 @@ class FrameSource:
         stamps: list[float] = []  # of the frames decoded, in ms (_uneven_steps)
         check = UNEVEN_FIRST_CHECK  # the stamps looked at for a variable rate at this many
         last: NDArray[np.uint8] | None = None
+        skip: tuple[int, int] | None = None  # the frame whose stamp first left the count
         try:
             while True:
                 ok, frame = cap.read()
@@ -2676,6 +2682,12 @@ class FrameSource:
                         start = stamp
                         if start > 0:
                             self._warn_cut_start(start, float(cap.get(cv2.CAP_PROP_POS_MSEC)))
+                    elif stamp - start > decoded:  # frames a decoder dropped without failing
+                        # (H.264): numbered by counting, as ever, and the stamps counted from
+                        # here, so that a later frame that fails is read on past (recount
+                        # alike); was: no resuming, the run ended there (stop 66's flip_h.mp4)
+                        skip = skip or (decoded, stamp - start)
+                        start = stamp - decoded
                     elif stamp - start != decoded:
                         timed = False  # not a constant-rate file: no resuming after damage
                 if not ok:
@@ -2704,6 +2716,8 @@ class FrameSource:
         finally:
             cap.release()
         self._warn_lost(lost, at_end=True)
+        if skip is not None and decoded < self._header_frames:  # not a variable rate's step
+            self._warn_skip(*skip)
         if not self._warned_short:  # read to the end (a stopped reader never gets here)
             self._warn_frame_count(decoded, stamps[-1] if stamps else None)
         if not self._warned_uneven:
@@ -2808,6 +2822,33 @@ class FrameSource:
             f"start?): a black frame stands in for each (the detector learns nothing from "
             f"one), so frame {index + 1}, the first that decodes, and the later frames keep "
             "their numbers (by their time stamps)",
+            UserWarning,
+        )
+
+    def _warn_skip(self, decoded: int, index: int) -> None:
+        """Warn, once, that the frame read as `decoded` (0-based) was stamped as frame `index`.
+
+        A damaged H.264 packet can make FFmpeg's decoder drop its frame, and the frames that
+        refer to it up to the next key frame, without failing a read: the stamps of the frames
+        read so far were in step with their count, and jump (a packet overwritten in a 60-frame
+        test file: frames 25-36 missing, 49 read). The frames are numbered as read, by
+        counting, as before; this says that from frame `decoded` + 1 on they are early against
+        tracks, detections or ground truth of the whole stream (was: only "its header says 60
+        frames but it holds 49 (counted): a truncated or damaged file"). Said at the end of a
+        whole pass, and only of a file whose header counts more frames than it read: a
+        variable rate's longer step (a Matroska file's) is no loss, and a file whose index
+        lost the packet as well (its header counts the frames it holds) cannot be told from
+        one. Forward jumps only.
+        """
+        if self._warned_skip or not decoded < index < self._header_frames:
+            return
+        self._warned_skip = True
+        warn_outside(
+            f"{self.path}: the time stamps skip from frame {decoded} to frame {index + 1}: "
+            f"{_frame_list(list(range(decoded, index)))} did not come from the decoder, without "
+            "an error (a damaged H.264 stream drops a frame and the frames up to the next key "
+            "frame); the later frames are numbered by counting, "
+            f"{index - decoded} early against detections or ground truth of the whole video",
             UserWarning,
         )
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib.util
+import os
 from fractions import Fraction
 from pathlib import Path
 from types import TracebackType
@@ -29,9 +30,11 @@ __all__ = [
     "MAX_CRF",
     "MAX_H264_SIDE",
     "VIDEO_SUFFIXES",
+    "RENDER_MARK",
     "X264_PRESETS",
     "VideoWriter",
     "check_frame_size",
+    "is_render",
     "pyav_available",
 ]
 
@@ -45,6 +48,55 @@ X264_PRESETS = (
     "ultrafast", "superfast", "veryfast", "faster", "fast", "medium", "slow", "slower",
     "veryslow",
 )  # fmt: skip
+
+
+#: What every video :class:`VideoWriter` writes carries, so that a later run can tell it from a
+#: user's video (:func:`is_render`): an MP4's ``comment`` tag; an AVI's header padding (the
+#: ``JUNK`` chunk before ``movi``, which players skip), where FFmpeg's muxer leaves one.
+RENDER_MARK = "pftrack render"
+_AVI_HEAD = 1 << 16  # bytes of an AVI read for its header (FFmpeg's: about 6 KiB)
+
+
+def _avi_padding(head: bytes) -> int | None:
+    """Where the payload of the ``JUNK`` chunk just before an AVI's ``movi`` list begins."""
+    movi = head.find(b"movi")
+    junk = head.rfind(b"JUNK", 0, movi) if movi > 0 else -1
+    if junk < 0:
+        return None
+    size = int.from_bytes(head[junk + 4 : junk + 8], "little")
+    return junk + 8 if size >= len(RENDER_MARK) and junk + 8 + size <= movi else None
+
+
+def _mark_avi(path: Path) -> None:
+    """Write :data:`RENDER_MARK` into the AVI `path`'s header padding, if it has room for it."""
+    with open(path, "r+b") as f:
+        head = f.read(_AVI_HEAD)
+        at = _avi_padding(head)
+        if at is not None and not head[at : at + len(RENDER_MARK)].strip(b"\0"):
+            f.seek(at)
+            f.write(RENDER_MARK.encode())
+
+
+def is_render(path: PathLike) -> bool:
+    """Whether the video at `path` was written by pftrack (:class:`VideoWriter`, stop 67 on).
+
+    The output checks replace an existing video only then (``--render``, ``pftrack render
+    --out``): any other video there is the user's.
+    """
+    try:
+        with open(path, "rb") as f:
+            head = f.read(_AVI_HEAD)
+        if head[:4] == b"RIFF" and head[8:12] == b"AVI ":
+            at = _avi_padding(head)
+            return at is not None and head[at : at + len(RENDER_MARK)] == RENDER_MARK.encode()
+        if head[4:8] != b"ftyp" or not pyav_available():
+            return False
+        import av
+
+        with av.open(os.fspath(path)) as container:
+            return bool(container.metadata.get("comment") == RENDER_MARK)
+    except Exception:  # unreadable, or not a video PyAV opens: not ours
+        return False
 
 
 def pyav_available() -> bool:
@@ -171,6 +223,7 @@ class VideoWriter:
             self._container = av.open(
                 str(self._tmp), mode="w", format="mp4", options={"movflags": "+faststart"}
             )
+            self._container.metadata["comment"] = RENDER_MARK  # is_render's
             stream = self._container.add_stream("libx264", rate=rate)
             stream.width, stream.height, stream.pix_fmt = w, h, "yuv420p"
             stream.options = {"crf": str(self.crf), "preset": self.preset}
@@ -297,6 +350,8 @@ class VideoWriter:
         if self._cv is not None:
             self._cv.release()
             self._cv = None
+            if self.codec == "mjpeg" and self._tmp.is_file():  # not a device written through
+                _mark_avi(self._tmp)
 
     def abort(self) -> None:
         """Stop and delete the partial file; an earlier file at `path` stays as it was."""
