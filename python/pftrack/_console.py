@@ -32,8 +32,7 @@ def _on_sigint(signum: int, frame: object) -> None:
     from pftrack import _interrupt  # loaded: main imports it before it sets this handler
 
     _interrupt.remember()
-    code = getattr(frame, "f_code", None)
-    if code is not None and code.co_filename.startswith(IMPORT_MACHINERY):
+    if _interrupt.in_import_machinery(frame):
         # inside importlib's own frames the interrupt may be raised into C that prints it: an
         # extension's init importing NumPy (OpenCV's import_array: PyErr_Print, a traceback,
         # then its own ImportError). Put off to the next line outside them, where it is raised
@@ -43,10 +42,6 @@ def _on_sigint(signum: int, frame: object) -> None:
         signal.raise_signal(signal.SIGINT)
         return
     raise KeyboardInterrupt
-
-
-#: Where importlib's frozen frames say they are (``<frozen importlib._bootstrap>``, ...).
-IMPORT_MACHINERY = "<frozen importlib."
 
 
 def _on_sigterm(signum: int, frame: object) -> None:

@@ -16,8 +16,10 @@ runs while anything may be half loaded).
 from __future__ import annotations
 
 __all__ = [
+    "IMPORT_MACHINERY",
     "Terminated",
     "clear",
+    "in_import_machinery",
     "interrupted",
     "raise_if_interrupted",
     "remember",
@@ -31,6 +33,23 @@ class Terminated(KeyboardInterrupt):
     Stated here, where nothing is imported, so that the console script's handler
     (:mod:`pftrack._console`) raises it while the command line is still being imported.
     """
+
+
+#: Where importlib's frozen frames say they are (``<frozen importlib._bootstrap>``, ...).
+IMPORT_MACHINERY = "<frozen importlib."
+
+
+def in_import_machinery(frame: object) -> bool:
+    """Whether a signal handler's `frame` is one of importlib's own (frozen) frames.
+
+    An exception a handler raises there may be raised into C that imports and prints it (a
+    traceback, then that import's own error): a late import (``import cv2`` in a command's
+    body, an extension's init importing NumPy) at the moment of a Ctrl-C or a SIGTERM. Such a
+    handler sends its signal again and returns; it runs again at the next line, outside them
+    once the import's frames return.
+    """
+    code = getattr(frame, "f_code", None)
+    return code is not None and code.co_filename.startswith(IMPORT_MACHINERY)
 
 
 _interrupted = [False]

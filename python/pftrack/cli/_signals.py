@@ -19,8 +19,7 @@ import threading
 from collections.abc import Iterator
 from typing import Any
 
-from pftrack._console import IMPORT_MACHINERY
-from pftrack._interrupt import Terminated
+from pftrack._interrupt import Terminated, in_import_machinery
 
 __all__ = [
     "EXIT_INTERRUPTED",
@@ -89,18 +88,6 @@ def _raise_terminated(signum: int, frame: Any) -> None:
     # its process group. sigterm_raises restores the handler when the command ends.
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     raise Terminated
-
-
-def in_import_machinery(frame: Any) -> bool:
-    """Whether a signal handler's `frame` is one of importlib's own (frozen) frames.
-
-    An exception a handler raises there may be raised into C that imports and prints it (a
-    traceback, then that import's own error): a late import (``import cv2`` in a command's
-    body) at the moment of a Ctrl-C or a SIGTERM. Such a handler sends its signal again and
-    returns; it runs again at the next line, outside them once the import's frames return.
-    """
-    code = getattr(frame, "f_code", None)
-    return code is not None and code.co_filename.startswith(IMPORT_MACHINERY)
 
 
 #: Set by the ``pftrack`` console script (:mod:`pftrack._console`): the process ends with the

@@ -123,7 +123,7 @@ class _StopOnCtrlC:
 
     def _handler(self, signum: int, frame: Any) -> None:
         if self.source.stopped:
-            from pftrack.cli._signals import in_import_machinery
+            from pftrack._interrupt import in_import_machinery
 
             if in_import_machinery(frame):  # raised at the next line outside importlib's
                 # frames (raised into C that imports, it was printed as a traceback)
