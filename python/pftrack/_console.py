@@ -32,15 +32,8 @@ def _on_sigint(signum: int, frame: object) -> None:
     from pftrack import _interrupt  # loaded: main imports it before it sets this handler
 
     _interrupt.remember()
-    if _interrupt.in_import_machinery(frame):
-        # inside importlib's own frames the interrupt may be raised into C that prints it: an
-        # extension's init importing NumPy (OpenCV's import_array: PyErr_Print, a traceback,
-        # then its own ImportError). Put off to the next line outside them, where it is raised
-        # in Python (the signal raised again: this handler runs at the next line run)
-        import signal  # loaded: main set this handler with it
-
-        signal.raise_signal(signal.SIGINT)
-        return
+    if _interrupt.put_off_in_imports(frame, signum):  # raised at the next line
+        return  # outside importlib's frames, not into C that prints it
     raise KeyboardInterrupt
 
 

@@ -19,8 +19,8 @@ __all__ = [
     "IMPORT_MACHINERY",
     "Terminated",
     "clear",
-    "in_import_machinery",
     "interrupted",
+    "put_off_in_imports",
     "raise_if_interrupted",
     "remember",
     "written_anyway",
@@ -39,17 +39,24 @@ class Terminated(KeyboardInterrupt):
 IMPORT_MACHINERY = "<frozen importlib."
 
 
-def in_import_machinery(frame: object) -> bool:
-    """Whether a signal handler's `frame` is one of importlib's own (frozen) frames.
+def put_off_in_imports(frame: object, signum: int) -> bool:
+    """Raise `signum` again and return True if a handler's `frame` is importlib's own.
+
+    A signal handler that gets True returns without raising.
 
     An exception a handler raises there may be raised into C that imports and prints it (a
     traceback, then that import's own error): a late import (``import cv2`` in a command's
-    body, an extension's init importing NumPy) at the moment of a Ctrl-C or a SIGTERM. Such a
-    handler sends its signal again and returns; it runs again at the next line, outside them
-    once the import's frames return.
+    body, an extension's init importing NumPy: OpenCV's ``import_array``) at the moment of a
+    Ctrl-C or a SIGTERM. The signal raised again runs the handler at the next line, outside
+    those frames once the import's frames return.
     """
     code = getattr(frame, "f_code", None)
-    return code is not None and code.co_filename.startswith(IMPORT_MACHINERY)
+    if code is None or not code.co_filename.startswith(IMPORT_MACHINERY):
+        return False
+    import signal  # loaded: a handler was set with it
+
+    signal.raise_signal(signum)
+    return True
 
 
 _interrupted = [False]

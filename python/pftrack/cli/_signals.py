@@ -19,7 +19,7 @@ import threading
 from collections.abc import Iterator
 from typing import Any
 
-from pftrack._interrupt import Terminated, in_import_machinery
+from pftrack._interrupt import Terminated, put_off_in_imports
 
 __all__ = [
     "EXIT_INTERRUPTED",
@@ -76,11 +76,8 @@ def line_end() -> str:
 
 
 def _raise_terminated(signum: int, frame: Any) -> None:
-    if in_import_machinery(frame):  # put off to the next line outside importlib's frames, as
-        # the console's SIGINT handler does (pftrack._console._on_sigint): raised into C that
-        # imports (an extension's init importing NumPy), Terminated was printed as a traceback
-        signal.raise_signal(signal.SIGTERM)  # this handler, still set, runs at the next line
-        return
+    if put_off_in_imports(frame, signum):  # raised into C that imports, Terminated
+        return  # was printed as a traceback: this handler, still set, runs at the next line
     # once: the command is unwinding (its writers removing their temporary files, its reader
     # threads stopping), and a second SIGTERM raised in that cleanup left a reader thread
     # inside a C++ read as the process exited, which aborted or crashed it ("FATAL: exception

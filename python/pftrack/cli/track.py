@@ -123,11 +123,9 @@ class _StopOnCtrlC:
 
     def _handler(self, signum: int, frame: Any) -> None:
         if self.source.stopped:
-            from pftrack._interrupt import in_import_machinery
+            from pftrack._interrupt import put_off_in_imports
 
-            if in_import_machinery(frame):  # raised at the next line outside importlib's
-                # frames (raised into C that imports, it was printed as a traceback)
-                signal.raise_signal(signal.SIGINT)
+            if put_off_in_imports(frame, signum):  # at the next line outside importlib
                 return
             # the abort, once: a third Ctrl-C raised in its cleanup could skip the wait for the
             # source's reader threads, and the process aborted at exit with a thread inside a
