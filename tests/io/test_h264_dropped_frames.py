@@ -106,3 +106,16 @@ def test_a_frame_that_fails_after_a_dropped_one_is_read_past(tmp_path: Path) -> 
     with pytest.warns(UserWarning, match="its header says 60 frames but it holds"):
         counted = FrameSource(path).recount()
     assert counted == len(frames)  # the count before a run agrees
+
+
+def test_the_dropped_frames_are_said_after_a_recount(tmp_path: Path) -> None:
+    """`pftrack track` recounts such a file before its tracking pass (the header's 60 against
+    49 found); the skip is still said then, against the header's count, not the recount's."""
+    path = _h264(tmp_path / "dropped.mp4", zeroed=25)
+    source = FrameSource(path)
+    with pytest.warns(UserWarning, match="its header says 60 frames but it holds"):
+        assert source.recount() == 49
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert len(list(source)) == 49
+    assert sum(SKIPPED in str(w.message) for w in caught) == 1
