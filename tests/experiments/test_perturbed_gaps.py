@@ -123,6 +123,35 @@ def test_zoom_scales_boxes_about_the_image_centre_and_draws_nothing(rows: np.nda
     np.testing.assert_array_equal(a[:, :2], rows[:, :2])  # frames and ids as they were
 
 
+def test_fps14_keeps_frames_at_14_of_30_renumbered(rows: np.ndarray) -> None:
+    a = ex.perturbed("s", rows, 480.0, 360.0, 10.0, "fps14", seed=0)
+    np.testing.assert_array_equal(a, ex.perturbed("t", rows, 480.0, 360.0, 25.0, "fps14", seed=3))
+    last = int(rows[:, 0].max())
+    old = [1 + round(k * 30 / 14) for k in range(last) if 1 + round(k * 30 / 14) <= last]
+    assert old[:6] == [1, 3, 5, 7, 10, 12]  # steps of 2 or 3 old frames, unevenly
+    assert set(np.diff(old)) == {2, 3}
+    for new, f in enumerate(old, start=1):
+        np.testing.assert_array_equal(a[a[:, 0] == new, 1:], rows[rows[:, 0] == f, 1:])
+    assert len(a) == int(np.isin(rows[:, 0], old).sum())  # the other frames are dropped
+    assert np.array_equal(np.unique(a[:, 0]), np.arange(1, len(old) + 1))
+
+
+def test_walk_scales_about_the_centre_from_1_to_1_5_over_the_file(rows: np.ndarray) -> None:
+    a = ex.perturbed("s", rows, 480.0, 360.0, 10.0, "walk", seed=0)
+    np.testing.assert_array_equal(a, ex.perturbed("t", rows, 480.0, 360.0, 30.0, "walk", seed=4))
+    f0, f1 = rows[:, 0].min(), rows[:, 0].max()
+    s = 1.0 + 0.5 * (rows[:, 0] - f0) / (f1 - f0)
+    np.testing.assert_allclose(a[:, 4:6], rows[:, 4:6] * s[:, None])
+    centre = np.array([240.0, 180.0])
+    for col in (0.0, 1.0):
+        got = a[:, 2:4] + col * a[:, 4:6] - centre
+        want = (rows[:, 2:4] + col * rows[:, 4:6] - centre) * s[:, None]
+        np.testing.assert_allclose(got, want, atol=1e-9)
+    np.testing.assert_array_equal(a[rows[:, 0] == f0], rows[rows[:, 0] == f0])  # 1 at the start
+    np.testing.assert_allclose(a[rows[:, 0] == f1, 4:6], 1.5 * rows[rows[:, 0] == f1, 4:6])
+    np.testing.assert_array_equal(a[:, :2], rows[:, :2])
+
+
 def _result(name: str, auto: float) -> SequenceResult:
     errors = {"auto": (auto, auto), "linear": (1.2, 1.2), "rts": (1.0, 1.0)}
     return SequenceResult(name, (480.0, 360.0), (), 2, errors)
