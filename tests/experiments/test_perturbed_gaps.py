@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from experiments import perturbed_gaps as ex
+from pftrack.io.mot import read_mot
 from pftrack.recovery.experiment import (
     SequenceResult,
     auto_masks,
@@ -16,6 +17,7 @@ from pftrack.recovery.experiment import (
     trajectories,
 )
 from pftrack.synthetic import make_scene
+from tests.conftest import dataset
 
 
 @pytest.fixture(scope="module")
@@ -204,6 +206,29 @@ def test_auto_is_not_worse_than_linear_on_syn0_thirdfps_at_the_right_edge() -> N
     assert len(run.gaps) == 8
     err = {
         m: np.mean([np.mean(g.errors(p)) for g, p in zip(run.gaps, run.paths[m], strict=True)])
+        for m in run.paths
+    }
+    assert err["auto"] <= err["linear"], err
+
+
+@pytest.mark.xfail(
+    strict=True,
+    raises=AssertionError,
+    reason="gaps of 5-8 frames validated on 7 artificial gaps of few short runs",
+)
+def test_auto_is_not_worse_than_linear_on_tud_campus_fps14() -> None:
+    # TUD-Campus resampled as a 30 fps file seen at 14 fps (fps14), its first mask: the
+    # bucket of 5-8 frames (4 real gaps) has 7 validation gaps, all at random places of short
+    # runs; they rate gdt-bi 3.73 px against linear 4.09, the real gaps 21.05 px summed
+    # against 19.78 (docs/recovery.md, stop 68).
+    gt = read_mot(dataset("tud-campus") / "gt.txt")
+    trajs = trajectories(ex.perturbed("TUD-Campus", gt, 640.0, 480.0, 25.0, "fps14", 0))
+    mask = auto_masks(trajs, 640.0, 480.0, 3)[0]
+    run = run_mask(trajs, mask, ("auto", "linear"), seed=0)
+    if mask[:2] != (243.0, 276.0) or len(run.gaps) != 7:  # not the case described: a failure
+        pytest.fail(f"mask {mask}, {len(run.gaps)} gaps: expected 243, 276 and 7 gaps")
+    err = {
+        m: sum(float(np.mean(g.errors(p))) for g, p in zip(run.gaps, run.paths[m], strict=True))
         for m in run.paths
     }
     assert err["auto"] <= err["linear"], err
