@@ -3,7 +3,7 @@
 The held-out goal of issue 12 asks for a default that is never worse than a straight line on
 sequences nobody chose it on: other cameras, frame rates and annotators. This script makes
 such conditions out of the data at hand. Each development sequence (the five real ones with
-ground truth and the three synthetic scenes of ``experiments.auto_seeds``) is perturbed four
+ground truth and the three synthetic scenes of ``experiments.auto_seeds``) is perturbed eight
 ways, in memory, and scored with the multi-sequence protocol of ``pftrack experiment gaps``
 (3 automatic masks per sequence, ``auto`` with calibration seed 0):
 
