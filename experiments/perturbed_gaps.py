@@ -3,7 +3,7 @@
 The held-out goal of issue 12 asks for a default that is never worse than a straight line on
 sequences nobody chose it on: other cameras, frame rates and annotators. This script makes
 such conditions out of the data at hand. Each development sequence (the five real ones with
-ground truth and the three synthetic scenes of ``experiments.auto_seeds``) is perturbed four
+ground truth and the three synthetic scenes of ``experiments.auto_seeds``) is perturbed eight
 ways, in memory, and scored with the multi-sequence protocol of ``pftrack experiment gaps``
 (3 automatic masks per sequence, ``auto`` with calibration seed 0):
 
@@ -19,11 +19,17 @@ ways, in memory, and scored with the multi-sequence protocol of ``pftrack experi
   at 10 fps, as KITTI-17 is;
 - ``zoom``: a smooth zoom of the camera, every box scaled about the image centre by
   ``1 + 0.15 sin(2 pi t / 10 s)`` (its corner moved toward or away from the centre, its width
-  and height scaled alike).
+  and height scaled alike);
+- ``fps14``: a 30 fps file seen at 14 fps, as ADL-Rundle-6 would be: new frame ``k`` (1, 2,
+  ...) is old frame ``1 + round((k - 1) 30 / 14)``, so the steps between kept frames are 2 or
+  3 old frames, unevenly (ratio 30/14 whatever the source's rate);
+- ``walk``: a camera walking forward, as ETH-Sunnyday's: every box scaled about the image
+  centre by ``1 + 0.5 (f - f0) / (f1 - f0)``, a drift from 1 at the file's first frame to 1.5
+  at its last (not periodic, unlike ``zoom``).
 
 The recovered paths are scored against the perturbed ground truth (what the perturbed file
 holds), so ``jitter``'s errors include the jitter itself. ``shake`` and ``jitter`` draw from
-``--seed``; the other four are the same with every seed (``--only shake,jitter`` runs the
+``--seed``; the other six are the same with every seed (``--only shake,jitter`` runs the
 ones a new seed changes). Prints, per perturbation and sequence, ``auto``, ``linear`` and the
 best fixed method, ``auto``'s excess over that best, ``<`` where ``auto`` is worse than
 ``linear``, and the gap-weighted pool of each perturbation; then the copies where ``auto`` is
@@ -99,6 +105,27 @@ def _zoom(rows: F64, width: float, height: float, fps: float, rng: np.random.Gen
     return out
 
 
+def _fps14(rows: F64, width: float, height: float, fps: float, rng: np.random.Generator) -> F64:
+    last = int(rows[:, 0].max())
+    old = 1 + np.rint(np.arange(last) * (30.0 / 14.0)).astype(int)  # old frame of new frame k
+    old = old[old <= last]
+    new = np.full(last + 1, 0)
+    new[old] = np.arange(1, len(old) + 1)
+    out = rows[new[rows[:, 0].astype(int)] > 0].copy()
+    out[:, 0] = new[out[:, 0].astype(int)]
+    return out
+
+
+def _walk(rows: F64, width: float, height: float, fps: float, rng: np.random.Generator) -> F64:
+    f0, f1 = rows[:, 0].min(), rows[:, 0].max()
+    s = 1.0 + 0.5 * (rows[:, 0] - f0) / max(f1 - f0, 1.0)
+    centre = np.array([width / 2.0, height / 2.0])
+    out = rows.copy()
+    out[:, 2:4] = centre + s[:, None] * (rows[:, 2:4] - centre)
+    out[:, 4:6] *= s[:, None]
+    return out
+
+
 PERTURBATIONS: dict[str, Perturb] = {
     "pan": _pan,
     "shake": _shake,
@@ -106,6 +133,8 @@ PERTURBATIONS: dict[str, Perturb] = {
     "jitter": _jitter,
     "thirdfps": _third_fps,
     "zoom": _zoom,
+    "fps14": _fps14,
+    "walk": _walk,
 }
 
 #: How far above the best fixed method a copy is listed as a miss (2 %).

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from experiments import perturbed_gaps as ex
+from pftrack.io.mot import read_mot
 from pftrack.recovery.experiment import (
     SequenceResult,
     auto_masks,
@@ -16,6 +17,7 @@ from pftrack.recovery.experiment import (
     trajectories,
 )
 from pftrack.synthetic import make_scene
+from tests.conftest import dataset
 
 
 @pytest.fixture(scope="module")
@@ -123,6 +125,35 @@ def test_zoom_scales_boxes_about_the_image_centre_and_draws_nothing(rows: np.nda
     np.testing.assert_array_equal(a[:, :2], rows[:, :2])  # frames and ids as they were
 
 
+def test_fps14_keeps_frames_at_14_of_30_renumbered(rows: np.ndarray) -> None:
+    a = ex.perturbed("s", rows, 480.0, 360.0, 10.0, "fps14", seed=0)
+    np.testing.assert_array_equal(a, ex.perturbed("t", rows, 480.0, 360.0, 25.0, "fps14", seed=3))
+    last = int(rows[:, 0].max())
+    old = [1 + round(k * 30 / 14) for k in range(last) if 1 + round(k * 30 / 14) <= last]
+    assert old[:6] == [1, 3, 5, 7, 10, 12]  # steps of 2 or 3 old frames, unevenly
+    assert set(np.diff(old)) == {2, 3}
+    for new, f in enumerate(old, start=1):
+        np.testing.assert_array_equal(a[a[:, 0] == new, 1:], rows[rows[:, 0] == f, 1:])
+    assert len(a) == int(np.isin(rows[:, 0], old).sum())  # the other frames are dropped
+    assert np.array_equal(np.unique(a[:, 0]), np.arange(1, len(old) + 1))
+
+
+def test_walk_scales_about_the_centre_from_1_to_1_5_over_the_file(rows: np.ndarray) -> None:
+    a = ex.perturbed("s", rows, 480.0, 360.0, 10.0, "walk", seed=0)
+    np.testing.assert_array_equal(a, ex.perturbed("t", rows, 480.0, 360.0, 30.0, "walk", seed=4))
+    f0, f1 = rows[:, 0].min(), rows[:, 0].max()
+    s = 1.0 + 0.5 * (rows[:, 0] - f0) / (f1 - f0)
+    np.testing.assert_allclose(a[:, 4:6], rows[:, 4:6] * s[:, None])
+    centre = np.array([240.0, 180.0])
+    for col in (0.0, 1.0):
+        got = a[:, 2:4] + col * a[:, 4:6] - centre
+        want = (rows[:, 2:4] + col * rows[:, 4:6] - centre) * s[:, None]
+        np.testing.assert_allclose(got, want, atol=1e-9)
+    np.testing.assert_array_equal(a[rows[:, 0] == f0], rows[rows[:, 0] == f0])  # 1 at the start
+    np.testing.assert_allclose(a[rows[:, 0] == f1, 4:6], 1.5 * rows[rows[:, 0] == f1, 4:6])
+    np.testing.assert_array_equal(a[:, :2], rows[:, :2])
+
+
 def _result(name: str, auto: float) -> SequenceResult:
     errors = {"auto": (auto, auto), "linear": (1.2, 1.2), "rts": (1.0, 1.0)}
     return SequenceResult(name, (480.0, 360.0), (), 2, errors)
@@ -175,6 +206,29 @@ def test_auto_is_not_worse_than_linear_on_syn0_thirdfps_at_the_right_edge() -> N
     assert len(run.gaps) == 8
     err = {
         m: np.mean([np.mean(g.errors(p)) for g, p in zip(run.gaps, run.paths[m], strict=True)])
+        for m in run.paths
+    }
+    assert err["auto"] <= err["linear"], err
+
+
+@pytest.mark.xfail(
+    strict=True,
+    raises=AssertionError,
+    reason="gaps of 5-8 frames validated on 7 artificial gaps of few short runs",
+)
+def test_auto_is_not_worse_than_linear_on_tud_campus_fps14() -> None:
+    # TUD-Campus resampled as a 30 fps file seen at 14 fps (fps14), its first mask: the
+    # bucket of 5-8 frames (4 real gaps) has 7 validation gaps, all at random places of short
+    # runs; they rate gdt-bi 3.73 px against linear 4.09, the real gaps 21.05 px summed
+    # against 19.78 (docs/recovery.md, stop 68).
+    gt = read_mot(dataset("tud-campus") / "gt.txt")
+    trajs = trajectories(ex.perturbed("TUD-Campus", gt, 640.0, 480.0, 25.0, "fps14", 0))
+    mask = auto_masks(trajs, 640.0, 480.0, 3)[0]
+    run = run_mask(trajs, mask, ("auto", "linear"), seed=0)
+    if mask[:2] != (243.0, 276.0) or len(run.gaps) != 7:  # not the case described: a failure
+        pytest.fail(f"mask {mask}, {len(run.gaps)} gaps: expected 243, 276 and 7 gaps")
+    err = {
+        m: sum(float(np.mean(g.errors(p))) for g, p in zip(run.gaps, run.paths[m], strict=True))
         for m in run.paths
     }
     assert err["auto"] <= err["linear"], err
