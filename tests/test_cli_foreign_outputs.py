@@ -121,11 +121,16 @@ def test_another_trackers_mot_file_is_replaced_as_motchallenge_tools_do(
 ) -> None:
     """A tracks file has no room for a mark: any MOTChallenge rows are a tracker's output."""
     out = tmp_path / "theirs.txt"
-    for text in ("1 1 10 10 5 5 1 -1 -1 -1\n", "# a comment\n\n2,3,1.5,2,3e1,4,0.9\n", "#\n"):
-        out.write_text(text)
+    for text in (
+        "1 1 10 10 5 5 1 -1 -1 -1\n",
+        "# a comment\n\n2,3,1.5,2,3e1,4,0.9\n",
+        "#\n",
+        "\ufeff1,1,10,10,5,5,1,-1,-1,-1\r\n",
+    ):  # a byte-order mark, as read_mot takes
+        out.write_text(text, encoding="utf-8")
         assert is_mot_text(out)
         assert main(["-q", "recover", str(inputs["gt"]), "--out", str(out)]) == 0
-        assert is_mot_text(out) and out.read_text() != text
+        assert is_mot_text(out) and out.read_text(encoding="utf-8") != text
     for text in ("frame,id,x,y,w,h\n", "1,2,3,4,5\n", "1,2,3,4,5,six\n", "\0binary"):
         out.write_text(text)
         assert not is_mot_text(out), text

@@ -144,7 +144,7 @@ def is_mot_text(path: PathLike) -> bool:
         return False
     if b"\0" in head:
         return False
-    text = head.decode("utf-8", errors="replace")
+    text = head.decode("utf-8-sig", errors="replace")  # a byte-order mark, as read_mot takes
     lines = text.splitlines()
     if len(head) == _HEAD and lines:
         lines = lines[:-1]  # the last may be cut
