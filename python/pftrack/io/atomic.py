@@ -817,7 +817,8 @@ def check_output(
         ``recover`` and ``smooth``): an existing file there that is not text (NUL bytes in its
         first 8 KiB: a video, a picture) is then refused, so that ``--out annotated.mp4``
         typed for ``--render annotated.mp4`` does not replace the video with text (was:
-        replaced without a word). A text file is replaced, as any output is.
+        replaced without a word). Which text file is replaced is :func:`check_replaceable`'s
+        (:func:`pftrack.io.marks.is_mot_text`: MOTChallenge rows, or ``--force``).
 
     Raises
     ------
