@@ -2277,10 +2277,10 @@ def test_rows_that_cannot_be_written_fail_their_task_not_the_batch(
     write_mot(folder / "fine.txt", fine)
     message = "write_mot: row 2 (frame 3, id 1) has left -1e+09: a box value is beyond ±1e+09 px"
     single = tmp_path / "single.txt"
-    single.write_text("earlier\n")
+    single.write_text("1,1,10,10,5,5,1,-1,-1,-1\n")  # an earlier run's (pftrack replaces no other)
     assert main(["smooth", str(folder / "edge.txt"), "--out", str(single)]) == 2
     assert capsys.readouterr().err == f"pftrack smooth: error: {message}\n"
-    assert single.read_text() == "earlier\n"
+    assert single.read_text() == "1,1,10,10,5,5,1,-1,-1,-1\n"
     out = tmp_path / "out"
     assert main(["smooth", str(folder), "--out", str(out), "--workers", "0"]) == 1  # some failed
     assert capsys.readouterr().err == f"edge: error: {message}\n"

@@ -19,6 +19,7 @@ from pftrack.eval import evaluate_mot, format_metrics
 from pftrack.io.mot import read_mot, write_mot
 from pftrack.synthetic import Scene, make_scene
 from pftrack.tracking import TrackerConfig
+from tests.earlier_outputs import TRACKS
 
 
 @pytest.fixture(scope="module")
@@ -728,12 +729,12 @@ def test_one_file_refuses_the_batch_options(
     for extra, named in (
         (["--workers", "0"], "--workers applies"),
         (["--scheduler", "tcp://127.0.0.1:1"], "--scheduler applies"),
-        (["--force", "--workers", "2"], "--workers, --force apply"),
-    ):
+        (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "--scheduler, --workers apply"),
+    ):  # --force is one file's too: an --out that holds no MOTChallenge rows (docs/io.md)
         assert main([command, str(src), "--out", str(out), *extra]) == 2
         assert capsys.readouterr().err.strip() == (
             f"pftrack {command}: error: {named} to a batch (several files or a folder); one "
-            "file runs in this process and --out is always written: drop it"
+            "file runs in this process: drop it"
         )
         assert not out.exists()
     # the environment's scheduler is for batches: one file does not refuse it
@@ -1027,14 +1028,14 @@ def test_a_track_write_error_names_the_output(
     out = tmp_path / "t.txt"
     argv = ["-q", "track", str(video), "--out", str(out), "--particles", "40", "--no-link"]
     if option == "--plot":  # a user trial: --out was replaced by the run that then failed
-        out.write_text("an older run\n")
+        out.write_bytes(TRACKS)  # an older run's tracks
     assert main([*argv, option, "/dev/full"]) == 2
     # was: "pftrack track: error: [Errno 28] No space left on device", no file named
     assert capsys.readouterr().err.strip().splitlines()[-1] == (
         "pftrack track: error: No space left on device: /dev/full"
     )
     if option == "--plot":
-        assert out.read_text() == "an older run\n"
+        assert out.read_bytes() == TRACKS
 
 
 @pytest.mark.parametrize(

@@ -60,8 +60,8 @@ def test_a_users_video_is_refused_and_a_render_replaced(
         assert main(_argv(command, inputs, given, tmp_path)) == 2
         assert capsys.readouterr().err == (
             f"pftrack {command}: error: {option} {given} is an existing file that pftrack did "
-            "not write (a video of yours?), and would be replaced: move it, or give another "
-            "name\n"
+            "not write (a video of yours?), and would be replaced: move it, give another "
+            "name, or pass --force\n"
         )
         assert video.read_bytes() == mine  # was: replaced, exit status 0
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([video.name, link.name])

@@ -29,6 +29,7 @@ from pftrack.io.mot import read_mot, write_mot
 from pftrack.io.video import FrameSource, read_seqinfo
 from pftrack.synthetic import Scene, make_scene
 from tests.conftest import dataset
+from tests.earlier_outputs import TRACKS
 from tests.io.streaming import serve_stream
 
 
@@ -638,7 +639,7 @@ def test_ctrl_c_on_a_file_aborts_and_keeps_the_old_outputs(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     out, video = tmp_path / "t.txt", tmp_path / "r.mp4"
-    out.write_text("keep\n")
+    out.write_bytes(TRACKS)
 
     def interrupted(*args: object, **kwargs: object) -> None:
         raise KeyboardInterrupt
@@ -648,7 +649,7 @@ def test_ctrl_c_on_a_file_aborts_and_keeps_the_old_outputs(
     assert main(argv) == 130
     # was: a blank line first, also into a file (it ends a progress bar's line on a terminal)
     assert capsys.readouterr().err == "pftrack track: interrupted; no output was changed\n"
-    assert out.read_text() == "keep\n"
+    assert out.read_bytes() == TRACKS
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]  # no partial video
     monkeypatch.setattr(sys.stderr, "isatty", lambda: True)  # as on a terminal
     assert main(argv) == 130
@@ -726,13 +727,13 @@ def test_sigterm_during_start_up_is_one_line_and_143(
     word); now it ends as a SIGTERM'd command does. Deterministic: the import of `module`
     sends it."""
     out = tmp_path / "t.txt"
-    out.write_text("keep\n")
+    out.write_bytes(TRACKS)
     argv = ["-q", "track", str(sequence), "--out", str(out)]
     proc = _track_stopped_at_import(module, argv, how, "os.kill(os.getpid(), signal.SIGTERM)")
     assert (proc.returncode, proc.stderr, proc.stdout) == (
         143, "pftrack track: terminated (SIGTERM); no output was changed\n", ""
     )  # fmt: skip
-    assert out.read_text() == "keep\n"
+    assert out.read_bytes() == TRACKS
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]
 
 
@@ -760,7 +761,7 @@ def test_live_stream_writes_rows_as_they_come_and_ctrl_c_ends_cleanly(
     det[:, 1], det[:, 6] = -1, 1.0
     write_mot(tmp_path / "det.txt", det)
     out, video = tmp_path / "live.txt", tmp_path / "live.mp4"
-    out.write_text("an earlier run\n")
+    out.write_bytes(TRACKS)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     with serve_stream(scene.frames, pace=0.05) as server:  # 10 s of video
         argv = [sys.executable, "-m", "pftrack.cli", "track", server.url, "--out", str(out),
@@ -779,7 +780,7 @@ def test_live_stream_writes_rows_as_they_come_and_ctrl_c_ends_cleanly(
                 proc.stderr.read().decode() if proc.poll() else "no rows"  # type: ignore[union-attr]
             )
             assert server.sent < len(scene.frames)  # rows came while the stream went on
-            assert out.read_text() == "an earlier run\n"  # replaced at the end only
+            assert out.read_bytes() == TRACKS  # replaced at the end only
             proc.send_signal(signal.SIGINT)
             stdout, stderr = proc.communicate(timeout=60)
         finally:
@@ -838,7 +839,7 @@ def test_an_aborted_live_run_keeps_out_and_says_where_its_rows_are(
     output was changed" (the user's earlier file lost).
     """
     out = tmp_path / "live.txt"
-    out.write_text("precious\n")
+    out.write_bytes(TRACKS)
     out.chmod(0o600)
     monkeypatch.setattr("pftrack.tracking.track_frames", _rows_then(abort))
     scene = make_scene(n_frames=5, rng=0)
@@ -851,7 +852,7 @@ def test_an_aborted_live_run_keeps_out_and_says_where_its_rows_are(
             f"pftrack track: {how} no output was changed; the 10 online rows tracked so far "
             f"are kept in {kept}\n"
         )
-        assert out.read_text() == "precious\n"
+        assert out.read_bytes() == TRACKS
         rows = read_mot(kept)
         assert rows.shape == (10, 10) and rows[:, 0].tolist() == [1, 1, 2, 2, 3, 3, 4, 4, 5, 5]
         assert stat.S_IMODE(kept.stat().st_mode) == 0o600  # as private as --out
@@ -869,13 +870,13 @@ def test_a_live_run_aborted_before_any_row_leaves_nothing(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out = tmp_path / "live.txt"
-    out.write_text("precious\n")
+    out.write_bytes(TRACKS)
     monkeypatch.setattr("pftrack.tracking.track_frames", _rows_then(KeyboardInterrupt(), 0))
     with serve_stream(make_scene(n_frames=5, rng=0).frames) as server:
         assert main(["-q", "track", server.url, "--out", str(out)]) == 130
     assert capsys.readouterr().err == "pftrack track: interrupted; no output was changed\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["live.txt"]
-    assert out.read_text() == "precious\n"
+    assert out.read_bytes() == TRACKS
 
 
 def test_ctrl_c_before_a_live_sources_first_frame_is_an_interrupt(

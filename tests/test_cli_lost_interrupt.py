@@ -21,6 +21,7 @@ from pathlib import Path
 import pytest
 
 from pftrack.synthetic import make_scene
+from tests.earlier_outputs import TRACKS
 
 # Ctrl-C inside the command's work, as in an import of NumPy's: the KeyboardInterrupt is
 # turned into an ImportError ("convert") or dropped ("drop") before the work goes on
@@ -54,7 +55,7 @@ HOOKS = {
 def _run(tmp_path: Path, command: str, how: str, **popen: object) -> tuple[int, str, Path]:
     tracks = make_scene(n_frames=20, n_walkers=2, rng=0).write_truth(tmp_path / "gt.txt")
     out = tmp_path / "out.txt"
-    out.write_text("an earlier run\n")
+    out.write_bytes(TRACKS)
     module, name = HOOKS[command]
     argv = [command, str(tracks), "--out", str(out)]
     code = SCRIPT.format(module=module, name=name, how=how, argv=argv)
@@ -72,7 +73,7 @@ def test_a_lost_ctrl_c_ends_the_command_as_interrupted(tmp_path, command, how):
     status, err, out = _run(tmp_path, command, how)
     assert status == 130, err
     assert err == f"pftrack {command}: interrupted; no output was changed\n"
-    assert out.read_text() == "an earlier run\n"
+    assert out.read_bytes() == TRACKS
     assert sorted(p.name for p in tmp_path.iterdir()) == ["gt.txt", "out.txt"]
 
 
@@ -135,7 +136,7 @@ def test_an_ignored_sigint_stays_ignored(tmp_path):
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN),
     )  # fmt: skip
     assert status == 0, err
-    assert out.read_text() != "an earlier run\n"
+    assert out.read_bytes() != TRACKS
 
 
 # ``python -m`` of a module that runs the command as ``python -m pftrack`` does, with Ctrl-C
@@ -275,7 +276,7 @@ def test_a_second_ctrl_c_as_the_command_ends_is_ignored(tmp_path: Path, when: st
     """
     tracks = make_scene(n_frames=20, n_walkers=2, rng=0).write_truth(tmp_path / "gt.txt")
     out = tmp_path / "out.txt"
-    out.write_text("an earlier run\n")
+    out.write_bytes(TRACKS)
     code = TWICE.format(when=when, argv=["recover", str(tracks), "--out", str(out)])
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     proc = subprocess.run(  # noqa: PLW1510 - the status is the test's
@@ -283,4 +284,4 @@ def test_a_second_ctrl_c_as_the_command_ends_is_ignored(tmp_path: Path, when: st
     )
     assert proc.returncode == 130, proc.stderr
     assert proc.stderr == "pftrack recover: interrupted; no output was changed\n"
-    assert out.read_text() == "an earlier run\n"
+    assert out.read_bytes() == TRACKS

@@ -22,6 +22,7 @@ from pftrack.cli import main
 from pftrack.io.mot import write_mot
 from pftrack.io.video_writer import VideoWriter
 from pftrack.synthetic import make_scene
+from tests.earlier_outputs import TRACKS, write_earlier
 
 ROOT = os.geteuid() == 0 if hasattr(os, "geteuid") else False
 
@@ -461,7 +462,7 @@ def test_interrupted_track_run_changes_no_output(
 
     out, video, plot = tmp_path / "t.txt", tmp_path / "v.mp4", tmp_path / "p.png"
     for p in (out, plot):
-        p.write_bytes(b"good result of an earlier run\n")
+        write_earlier(p)  # an earlier run's: pftrack replaces no other
     with VideoWriter(video, fps=5) as writer:  # an earlier render: pftrack replaces no other
         writer.write(np.zeros((16, 16, 3), np.uint8))
     real_track = tracking.track_frames
@@ -637,7 +638,7 @@ def test_experiment_figure_is_kept_when_its_json_cannot_be_written(
 ) -> None:
     """Was: exit 2 for --json /dev/full, the user's --figure replaced by the failed run's."""
     gt = _walkers(tmp_path / "A")
-    (tmp_path / "f.png").write_bytes(b"an earlier figure\n")
+    write_earlier(tmp_path / "f.png")
     before = _snapshot(tmp_path)
     argv = ["-q", "experiment", "gaps", "--gt", str(gt), "--methods", "linear", "--repeat", "1",
             "--max-positions", "1", "--json", "/dev/full",
@@ -662,7 +663,7 @@ def test_outputs_through_symlinks_replace_the_target_and_keep_the_link(
     real = tmp_path / "real"
     real.mkdir()
     for name in ("t.txt", "v.mp4", "r.txt", "in.txt"):
-        (real / name).write_text("old\n")
+        (real / name).write_bytes(TRACKS)  # an earlier run's
         (tmp_path / name).symlink_to(Path("real") / name)
     with VideoWriter(real / "v.mp4", fps=5) as writer:  # an earlier render: pftrack's own
         writer.write(np.zeros((16, 16, 3), np.uint8))
@@ -675,7 +676,7 @@ def test_outputs_through_symlinks_replace_the_target_and_keep_the_link(
     assert main([*argv, "--out", str(tmp_path / "in.txt"), "--in-place"]) == 0
     for name in ("t.txt", "v.mp4", "r.txt", "in.txt"):
         assert (tmp_path / name).is_symlink(), name
-        assert (real / name).read_bytes() != b"old\n", name
+        assert (real / name).read_bytes() != TRACKS, name
     assert (real / "in.txt").read_bytes() == (real / "r.txt").read_bytes()
     assert sorted(p.name for p in real.iterdir()) == ["in.txt", "r.txt", "t.txt", "v.mp4"]
 
@@ -873,7 +874,7 @@ def test_sigterm_is_handled_as_ctrl_c(tmp_path: Path) -> None:
     out = tmp_path / "out"
     out.mkdir()
     for name in ("t.txt", "t.mp4"):
-        (out / name).write_bytes(b"an earlier result\n")
+        (out / name).write_bytes(TRACKS)  # an earlier result
     with VideoWriter(out / "t.mp4", fps=5) as writer:  # an earlier render: pftrack's own
         writer.write(np.zeros((16, 16, 3), np.uint8))
     before = _snapshot(out)
@@ -961,7 +962,7 @@ def test_no_tracks_into_a_device_or_pipe_is_an_empty_output(
     [
         ("track VIDEO --out t.txt --render OUT --plot /dev/null --particles 20", b"ftyp"),
         ("track VIDEO --out t.txt --plot OUT --render /dev/null --particles 20", b"\x89PNG"),
-        ("eval --gt GT --res TRACKS --json OUT --csv /dev/null", b'{\n  "hota"'),
+        ("eval --gt GT --res TRACKS --json OUT --csv /dev/null", b'{\n  "written_by"'),
         ("eval --gt GT --res TRACKS --csv OUT --json /dev/null", b"sequence,"),
         ("experiment gaps --gt WALKERS --figure OUT --json /dev/null --methods linear "
          "--repeat 1 --max-positions 1", b"\x89PNG"),

@@ -23,6 +23,8 @@ from pftrack import _interrupt
 from pftrack.cli import main
 from pftrack.io.mot import write_mot
 from pftrack.synthetic import make_scene
+from tests.earlier_outputs import earlier as earlier_bytes
+from tests.earlier_outputs import write_earlier
 
 EARLIER = b"an earlier run's output\n"
 
@@ -45,17 +47,9 @@ def _flag_cleared() -> Iterator[None]:
 
 
 def _write_earlier(path: Path) -> None:
-    """An earlier run's output at `path`: text, or for a video an earlier pftrack render (pftrack
-    replaces no other video)."""
-    if path.suffix != ".mp4":
-        path.write_bytes(EARLIER)
-        return
-    import numpy as np
-
-    from pftrack.io.video_writer import VideoWriter
-
-    with VideoWriter(path, fps=5) as writer:
-        writer.write(np.zeros((16, 16, 3), np.uint8))
+    """An earlier run's output at `path`, of its kind as pftrack writes it (pftrack replaces
+    no file of another's: tests/earlier_outputs.py)."""
+    write_earlier(path)
 
 
 def _snapshot(folder: Path) -> dict[str, bytes | None]:
@@ -262,11 +256,11 @@ def test_eval_writes_both_its_files_or_neither(
 
     monkeypatch.setattr(sequences, "scores_csv", dropped_then_csv)
     for name in ("e.json", "e.csv"):
-        (tmp_path / name).write_bytes(EARLIER)
+        _write_earlier(tmp_path / name)
     argv = COMMANDS["eval"][1](inputs, tmp_path)
     assert main(["-q", *argv]) == 130
     assert capsys.readouterr().err == _said("eval")
-    assert _snapshot(tmp_path) == {"e.json": EARLIER, "e.csv": EARLIER}
+    assert _snapshot(tmp_path) == {"e.json": earlier_bytes(".json"), "e.csv": earlier_bytes(".csv")}
 
 
 @pytest.mark.parametrize("command", ["eval", "experiment"])

@@ -860,7 +860,7 @@ def plot_trajectories(
                 canvas, text_for_opencv(line), (5, 15 + 16 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.45,
                 (255, 255, 255), 1, cv2.LINE_AA,
             )  # fmt: skip
-    return write_image(path, canvas)  # any name (pftrack.io.opencv_io)
+    return write_image(path, canvas, mark=True)  # any name (pftrack.io.opencv_io)
 
 
 def _wrapped(text: str, width: int, scale: float) -> list[str]:

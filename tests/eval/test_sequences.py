@@ -615,6 +615,7 @@ def test_json_layouts_and_every_scalar_as_docs_eval_md_gives_them(
     ``hota0`` (HOTA at alpha 0.05) was in neither the JSON nor the CSV, which the docs said
     hold every scalar.
     """
+    import pftrack
     from pftrack.eval import MotMetrics
 
     cases = {"A": random_case(0)}
@@ -628,7 +629,10 @@ def test_json_layouts_and_every_scalar_as_docs_eval_md_gives_them(
         rows = list(csv.DictReader(table.read_text().splitlines()))
         assert len(rows) == 1 and rows[0]["sequence"] == "A" and "hota0" in rows[0]
     capsys.readouterr()
-    assert list(docs["folder"]) == ["sequences"]  # one sequence: no "combined"
+    # one sequence: no "combined"; pftrack's mark first (stop 68: docs/io.md)
+    assert list(docs["folder"]) == ["written_by", "sequences"]
+    mark = f"pftrack {pftrack.__version__} eval"
+    assert docs["file"].pop("written_by") == docs["folder"]["written_by"] == mark
     assert docs["folder"]["sequences"]["A"] == docs["file"]
     metrics = docs["file"]
     h = evaluate_hota(*(read_mot(p) for p in (gt_root / "A/gt/gt.txt", res_root / "A.txt")))

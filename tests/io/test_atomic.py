@@ -687,7 +687,7 @@ def test_a_longest_valid_name_is_written(tmp_path: Path, name: str) -> None:
                 out.write("x\n")
         assert (tmp_path / name).read_text() == "x\n"
     with staged_outputs() as stage:
-        stage(tmp_path / name).write_text("y\n")
+        stage(tmp_path / name).write_text("1,1,10,10,5,5,1,-1,-1,-1\n")  # tracks: recover's below
     assert sorted(p.name for p in tmp_path.iterdir()) == [name]
     rows = tmp_path / "t.txt"
     write_mot(rows, [[1, 1, 10, 10, 5, 5, 1, -1, -1, -1], [3, 1, 14, 10, 5, 5, 1, -1, -1, -1]])

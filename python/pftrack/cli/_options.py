@@ -670,3 +670,21 @@ def report_stream(*outputs: str | None) -> Any:
     import sys
 
     return sys.stderr if is_stdout(*outputs) else sys.stdout
+
+
+#: What a file an output option would replace may be, for the message of
+#: :func:`~pftrack.io.atomic.check_replaceable` (a picture, a JSON or CSV file: the user's).
+YOURS = "pftrack did not write (a file of yours?)"
+
+
+def add_force(parser: argparse.ArgumentParser) -> None:
+    """``--force``: replace output files pftrack did not write (docs/io.md's one rule)."""
+    parser.add_argument(
+        "--force", action="store_true",
+        help="replace an existing output file that pftrack did not write (default: refused, "
+        "exit 2; absent, empty and pftrack's own files are always replaced)",
+    )  # fmt: skip
+
+
+#: The same for a tracks ``--out``: a file that holds no MOTChallenge rows.
+TRACKS_YOURS = "holds no MOTChallenge rows (a file of yours?)"

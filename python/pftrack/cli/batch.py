@@ -79,11 +79,13 @@ def add_batch_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--force", action="store_true",
                    help="redo inputs whose outputs are complete, instead of skipping "
                    "them, and replace files of the outputs' names in DIR that no earlier "
-                   "batch wrote (refused without it)")  # fmt: skip
+                   "batch wrote (refused without it); given one file, replace an --out that "
+                   "holds no MOTChallenge rows (refused without it)")  # fmt: skip
 
 
-#: The options of :func:`add_batch_options`, which a command given one file does not use.
-BATCH_ONLY = ("scheduler", "workers", "force")
+#: The options of :func:`add_batch_options`, which a command given one file does not use
+#: (``--force`` it does: an ``--out`` that pftrack would not replace, docs/io.md).
+BATCH_ONLY = ("scheduler", "workers")
 
 
 def refuse_batch_options(args: argparse.Namespace) -> None:
@@ -92,7 +94,7 @@ def refuse_batch_options(args: argparse.Namespace) -> None:
     Raises
     ------
     ValueError
-        ``--scheduler``, ``--workers`` or ``--force`` was given (``$DASK_SCHEDULER_ADDRESS``
+        ``--scheduler`` or ``--workers`` was given (``$DASK_SCHEDULER_ADDRESS``
         is not: it is read only by a batch).
     """
     given = [
@@ -103,8 +105,7 @@ def refuse_batch_options(args: argparse.Namespace) -> None:
     if given:
         raise ValueError(
             f"{', '.join(given)} {'applies' if len(given) == 1 else 'apply'} to a batch "
-            "(several files or a folder); one file runs in this process and --out is always "
-            "written: drop it"
+            "(several files or a folder); one file runs in this process: drop it"
         )
 
 

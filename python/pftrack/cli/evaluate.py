@@ -10,8 +10,10 @@ from typing import TYPE_CHECKING, Any
 
 from pftrack.cli._options import (
     IOU_HELP,
+    YOURS,
     WidthHeight,
     add_command,
+    add_force,
     bounded_int,
     iou_threshold,
     report_stream,
@@ -100,6 +102,7 @@ def add_parser(sub: Any) -> None:
     )  # fmt: skip
     p.add_argument("--json", default=None, help="also write all metrics to this JSON file")
     p.add_argument("--csv", default=None, help="also write the table's scores to this CSV file")
+    add_force(p)
     p.set_defaults(func=run)
 
 
@@ -296,7 +299,8 @@ def run(args: argparse.Namespace) -> int:
         scores_csv,
         scores_json,
     )
-    from pftrack.io.atomic import check_output, staged_outputs
+    from pftrack.io.atomic import check_output, check_replaceable, staged_outputs
+    from pftrack.io.marks import is_marked_csv, is_marked_json, json_marked
     from pftrack.io.mot import no_rows, read_ground_truth, read_mot
     from pftrack.recovery.linking import check_scored_ids
 
@@ -308,6 +312,10 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.json, what="--json", suffixes=(".json",), inputs=inputs)
     if args.csv is not None:
         check_output(args.csv, what="--csv", suffixes=(".csv",), inputs=inputs)
+    if args.json:
+        check_replaceable(args.json, "--json", is_marked_json, force=args.force, yours=YOURS)
+    if args.csv:
+        check_replaceable(args.csv, "--csv", is_marked_csv, force=args.force, yours=YOURS)
     names = [name for name, _, _ in jobs]
     scales = _scales(args.scale or [], names, _left_out(args, names))
 
@@ -384,9 +392,10 @@ def run(args: argparse.Namespace) -> int:
     with staged_outputs() as stage:
         if args.json:
             if Path(args.gt).is_file():  # one file: its metrics at the top level, as before
-                text = json.dumps(next(iter(scores.values())).as_dict(), indent=2)
+                doc = next(iter(scores.values())).as_dict()
             else:
-                text = scores_json(scores, combined)
+                doc = json.loads(scores_json(scores, combined))
+            text = json.dumps(json_marked(doc, "eval"), indent=2)
             with stage(args.json, ".json").open("w") as fh:
                 fh.write(text + "\n")
         if args.csv:

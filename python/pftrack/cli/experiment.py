@@ -11,8 +11,10 @@ from typing import Any
 
 from pftrack._warn import warn
 from pftrack.cli._options import (
+    YOURS,
     WidthHeight,
     add_command,
+    add_force,
     bounded_float,
     bounded_int,
     counted,
@@ -117,6 +119,7 @@ def add_parser(sub: Any) -> None:
     g.add_argument("--figure", metavar="PNG",
                    help="one sequence: PNG of ground truth against recovered paths under the "
                    "representative mask (default: none)")  # fmt: skip
+    add_force(g)
     g.set_defaults(func=run_gaps)
 
 
@@ -257,7 +260,8 @@ def _check_distinct_gt(paths: list[str]) -> None:
 
 def run_gaps(args: argparse.Namespace) -> int:
     """Run ``pftrack experiment gaps``; return the exit status."""
-    from pftrack.io.atomic import check_distinct, check_output
+    from pftrack.io.atomic import check_distinct, check_output, check_replaceable
+    from pftrack.io.marks import is_marked_image, is_marked_json
 
     multi = _check_mode(args)  # before any other check: the options a mode does not use
     _check_distinct_gt(args.gt)
@@ -272,6 +276,10 @@ def run_gaps(args: argparse.Namespace) -> int:
         check_output(args.figure, what="--figure", suffixes=FIGURE_SUFFIXES, inputs=inputs)
     # was: --json /dev/stdout --figure /dev/stdout wrote a PNG and the JSON into one stream
     check_distinct({"--json": args.json, "--figure": args.figure})
+    if args.json:
+        check_replaceable(args.json, "--json", is_marked_json, force=args.force, yours=YOURS)
+    if args.figure:
+        check_replaceable(args.figure, "--figure", is_marked_image, force=args.force, yours=YOURS)
     if multi:
         return _run_sequences(args)
     import numpy as np
@@ -407,16 +415,17 @@ def _finish(args: argparse.Namespace, said: list[str], doc: dict[str, Any], figu
     import cv2
 
     from pftrack.io.atomic import output_format, staged_outputs
+    from pftrack.io.marks import json_marked
     from pftrack.io.opencv_io import write_image
 
     with staged_outputs() as stage:
         if args.figure:
             ext = output_format(args.figure, FIGURE_SUFFIXES)  # a device (/dev/stdout): .png
             params = [cv2.IMWRITE_PNG_COMPRESSION, 9]
-            write_image(stage(args.figure, ext), figure, params, ext=ext)
+            write_image(stage(args.figure, ext), figure, params, ext=ext, mark=True)
         if args.json:
             with open(stage(args.json), "w", encoding="utf-8") as f:
-                json.dump(doc, f, indent=1)
+                json.dump(json_marked(doc, "experiment gaps"), f, indent=1)
         if args.figure or args.json:  # (none: nothing was written, as a report error says)
             hold_interrupts()  # the work is done: the outputs are put in place whatever comes
     said += [f"{what}: {path}" for what, path in (("figure", args.figure), ("json", args.json))
@@ -449,9 +458,10 @@ def _write_json(path: str, doc: dict[str, Any]) -> None:
     import json
 
     from pftrack.io.atomic import atomic_write
+    from pftrack.io.marks import json_marked
 
     with atomic_write(path) as f:
-        json.dump(doc, f, indent=1)
+        json.dump(json_marked(doc, "experiment gaps"), f, indent=1)
 
 
 def _run_sequences(args: argparse.Namespace) -> int:

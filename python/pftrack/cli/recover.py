@@ -10,6 +10,7 @@ from typing import Any
 
 from pftrack.cli import batch
 from pftrack.cli._options import (
+    TRACKS_YOURS,
     add_command,
     add_max_distance,
     counted,
@@ -80,7 +81,8 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("--video is used only by --link (its colour term); add --link or drop it")
     args.tracks = args.tracks[0]
     from pftrack.cli._signals import hold_interrupts
-    from pftrack.io.atomic import check_output
+    from pftrack.io.atomic import check_output, check_replaceable
+    from pftrack.io.marks import is_mot_text
     from pftrack.io.mot import write_mot
     from pftrack.recovery import fill_gaps, link_tracklets
     from pftrack.recovery.fill import copied_values, unfilled_note
@@ -98,6 +100,8 @@ def run(args: argparse.Namespace) -> int:
 
         inputs = tuple(source_files(args.video))
     check_output(args.out, what="--out", inputs=inputs, tracks=True)
+    if not args.in_place:  # --in-place: --out is the input, its rows read
+        check_replaceable(args.out, "--out", is_mot_text, force=args.force, yours=TRACKS_YOURS)
     if args.video:  # an image --out beside its frames: one more frame of the next run
         from pftrack.io.video import check_outside_frames
 

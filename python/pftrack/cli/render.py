@@ -16,7 +16,9 @@ from typing import Any
 
 from pftrack.cli._options import (
     FPS_RANGE,
+    YOURS,
     add_command,
+    add_force,
     bounded_float,
     check_input_file,
     counted,
@@ -50,6 +52,7 @@ def add_parser(sub: Any) -> None:
         "extension (/dev/stdout): .mp4. Written atomically. An odd width or height gets one "
         "copied column or row (4:2:0), as pftrack track --render",
     )  # fmt: skip
+    add_force(p)
     p.add_argument(
         "--scale", type=bounded_float(1e-3, 1e3), default=1.0, metavar="S",
         help="multiply the file's boxes by S to reach the video's pixels (0.001 to 1000; "
@@ -88,6 +91,7 @@ def run(args: argparse.Namespace) -> int:
         output_format,
         staged_outputs,
     )
+    from pftrack.io.marks import is_marked_image
     from pftrack.io.video import (
         FrameSource,
         check_outside_frames,
@@ -111,7 +115,9 @@ def run(args: argparse.Namespace) -> int:
     if args.plot is not None:  # "" too: refused as empty (was: no plot, without a word)
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     check_distinct({"--out": args.out, "--plot": args.plot})
-    check_replaceable(args.out, "--out", is_render)
+    check_replaceable(args.out, "--out", is_render, force=args.force)
+    if args.plot:
+        check_replaceable(args.plot, "--plot", is_marked_image, force=args.force, yours=YOURS)
     check_outside_frames({"--out": args.out, "--plot": args.plot}, args.source)
     rows = read_tracks(args.tracks, tracks_only=False)  # id -1 rows drawn, as any other
     rows[:, 2:6] *= args.scale

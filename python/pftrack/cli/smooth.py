@@ -8,7 +8,13 @@ from pathlib import Path
 from typing import Any
 
 from pftrack.cli import batch
-from pftrack.cli._options import add_command, add_max_distance, counted, report_stream
+from pftrack.cli._options import (
+    TRACKS_YOURS,
+    add_command,
+    add_max_distance,
+    counted,
+    report_stream,
+)
 
 
 def add_parser(sub: Any) -> None:
@@ -53,7 +59,8 @@ def run(args: argparse.Namespace) -> int:
     from pftrack._stats import unique_values
     from pftrack.cli._signals import hold_interrupts
     from pftrack.cli.recover import flag_note
-    from pftrack.io.atomic import check_output
+    from pftrack.io.atomic import check_output, check_replaceable
+    from pftrack.io.marks import is_mot_text
     from pftrack.io.mot import write_mot
     from pftrack.recovery.fill import long_holes, unfilled_note
     from pftrack.recovery.linking import link_config_for, read_tracks
@@ -64,6 +71,7 @@ def run(args: argparse.Namespace) -> int:
     if out.exists() and src.exists() and os.path.samefile(out, src):
         raise ValueError(f"--out {out} is the input file; write the result elsewhere")
     check_output(args.out, what="--out", tracks=True)
+    check_replaceable(args.out, "--out", is_mot_text, force=args.force, yours=TRACKS_YOURS)
     rows = read_tracks(src)
     link = None if args.no_link else link_config_for(rows, args.max_gap, args.max_distance)
     result = smooth_tracks(rows, link=link, max_gap=args.max_gap)

@@ -13,7 +13,10 @@ from typing import IO, Any
 from pftrack.cli._options import (
     DET_SCALE_RANGE,
     FPS_RANGE,
+    TRACKS_YOURS,
+    YOURS,
     add_command,
+    add_force,
     add_tracker_options,
     bounded_float,
     counted,
@@ -63,6 +66,7 @@ def add_parser(sub: Any) -> None:
         help="video file, image folder, MOTChallenge sequence folder, camera index or URL",
     )
     p.add_argument("--out", required=True, help="tracks in MOTChallenge format (e.g. tracks.txt)")
+    add_force(p)
     p.add_argument(
         "--detections", metavar="FILE",
         help="MOTChallenge detection file (frame,-1,l,t,w,h,score,...), or 'auto' for the "
@@ -237,6 +241,7 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     """Before any work: the detection file can be read, every output written, none twice."""
     from pftrack.cli._options import check_input_file
     from pftrack.io.atomic import check_distinct, check_output, check_replaceable
+    from pftrack.io.marks import is_marked_image, is_mot_text
     from pftrack.io.video import check_outside_frames, find_sequence, source_files
     from pftrack.io.video_writer import VIDEO_SUFFIXES, is_render
 
@@ -257,8 +262,12 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
         check_output(args.plot, what="--plot", suffixes=PLOT_SUFFIXES, inputs=inputs)
     outputs = {"--out": args.out, "--render": args.render, "--plot": args.plot}
     check_distinct(outputs)
+    force = args.force
+    check_replaceable(args.out, "--out", is_mot_text, force=force, yours=TRACKS_YOURS)
     if args.render:
-        check_replaceable(args.render, "--render", is_render)
+        check_replaceable(args.render, "--render", is_render, force=force)
+    if args.plot:
+        check_replaceable(args.plot, "--plot", is_marked_image, force=force, yours=YOURS)
     if not live:
         check_outside_frames(outputs, args.source)
 

@@ -817,7 +817,8 @@ def check_output(
         ``recover`` and ``smooth``): an existing file there that is not text (NUL bytes in its
         first 8 KiB: a video, a picture) is then refused, so that ``--out annotated.mp4``
         typed for ``--render annotated.mp4`` does not replace the video with text (was:
-        replaced without a word). A text file is replaced, as any output is.
+        replaced without a word). Which text file is replaced is :func:`check_replaceable`'s
+        (:func:`pftrack.io.marks.is_mot_text`: MOTChallenge rows, or ``--force``).
 
     Raises
     ------
@@ -875,17 +876,30 @@ def check_output(
     return target
 
 
-def check_replaceable(path: PathLike, what: str, ours: Callable[[Path], bool]) -> None:
+def check_replaceable(
+    path: PathLike,
+    what: str,
+    ours: Callable[[Path], bool],
+    *,
+    force: bool = False,
+    yours: str = "pftrack did not write (a video of yours?)",
+) -> None:
     """Refuse to replace a non-empty file at `path` that `ours` says pftrack did not write.
 
-    `ours`: :func:`pftrack.io.video_writer.is_render` for a video output. Called after
-    :func:`check_output` and :func:`check_distinct`, whose messages say more.
+    The one rule of every output option (docs/io.md, "What an output may replace"): an absent
+    path, an empty file, a device or pipe, or a file `ours` accepts is replaced; any other is
+    refused, unless `force` (the command's ``--force``). `ours`: a test of the output's kind
+    (:func:`pftrack.io.video_writer.is_render`, :mod:`pftrack.io.marks`); `yours` what such
+    a file is, and may be, for the message. Called after :func:`check_output` and
+    :func:`check_distinct`, whose messages say more.
 
     Raises
     ------
     ValueError
-        Such a file, naming `what` (was: a user's video replaced, exit status 0).
+        Such a file, naming `what` (was: a user's file replaced, exit status 0).
     """
+    if force:
+        return
     text = os.fsdecode(os.fspath(path))
     written = _resolve(text)
     if written.through:
@@ -897,8 +911,8 @@ def check_replaceable(path: PathLike, what: str, ours: Callable[[Path], bool]) -
         return
     if not ours(written.path):
         raise ValueError(
-            f"{what} {text} is an existing file that pftrack did not write (a video of yours?), "
-            "and would be replaced: move it, or give another name"
+            f"{what} {text} is an existing file that {yours}, "
+            "and would be replaced: move it, give another name, or pass --force"
         )
 
 

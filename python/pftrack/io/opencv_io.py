@@ -267,7 +267,12 @@ def read_image_depth(path: PathLike, *, notes: list[str] | None = None) -> NDArr
 
 
 def write_image(
-    path: PathLike, image: NDArray[Any], params: Sequence[int] = (), *, ext: str | None = None
+    path: PathLike,
+    image: NDArray[Any],
+    params: Sequence[int] = (),
+    *,
+    ext: str | None = None,
+    mark: bool = False,
 ) -> Path:
     """Write `image` as ``cv2.imwrite`` would (the same bytes), atomically; return `path`.
 
@@ -284,6 +289,9 @@ def write_image(
         Encoder parameters (``[cv2.IMWRITE_PNG_COMPRESSION, 9]``).
     ext : str, optional
         The format (``".png"``); default: `path`'s extension.
+    mark : bool
+        Whether a PNG or JPEG carries pftrack's mark (:func:`pftrack.io.marks.mark_image`,
+        the same pixels), which lets a later run replace it: ``--plot``'s and ``--figure``'s.
 
     Raises
     ------
@@ -299,6 +307,11 @@ def write_image(
         raise ValueError(
             f"OpenCV cannot write image {printable(path)} (format {suffix or '(none)'!r})"
         )
+    data = buf.tobytes()
+    if mark:
+        from pftrack.io.marks import mark_image
+
+        data = mark_image(data)
     with atomic_write(path, "wb") as fh:
-        fh.write(buf.tobytes())
+        fh.write(data)
     return Path(path)
