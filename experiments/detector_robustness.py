@@ -25,11 +25,13 @@ Usage (from the repository root)::
     python -m experiments.detector_robustness [--data ../shared/data]
         [--sequences pets,tud,walkers,present,groups,overhead] [--variants ident,grey,ramp]
         [--detector paper] [--bootstrap auto] [--seed 0] [--hold-frames 0]
-        [--grey-t-min T] [--grey-shadow-lo LO] [--out out/detector_robustness]
+        [--grey-t-min T] [--grey-shadow-lo LO] [--grey-texture C] [--grey-texture-window W]
+        [--grey-texture-erode E] [--out out/detector_robustness]
 
 ``--grey-t-min`` and ``--grey-shadow-lo`` set ``PaperConfig.grey_t_min`` and
-``grey_shadow_lo`` (the built-in detector's threshold bound and shadow bound on grey video;
-colour video is not affected).
+``grey_shadow_lo`` (the built-in detector's threshold bound and shadow bound on grey video),
+``--grey-texture*`` its ``grey_texture``, ``grey_texture_window``, ``grey_texture_erode``
+(the texture cue on grey video, off by default); colour video is not affected.
 """
 
 from __future__ import annotations
@@ -160,6 +162,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     p.add_argument("--grey-t-min", type=float, default=None, help="PaperConfig.grey_t_min")
     p.add_argument("--grey-shadow-lo", type=float, default=None, help="PaperConfig.grey_shadow_lo")
+    p.add_argument("--grey-texture", type=float, default=None, help="PaperConfig.grey_texture")
+    p.add_argument(
+        "--grey-texture-window", type=int, default=None, help="PaperConfig.grey_texture_window"
+    )
+    p.add_argument(
+        "--grey-texture-erode", type=int, default=None, help="PaperConfig.grey_texture_erode"
+    )
     args = p.parse_args(argv)
     from pftrack.detection import PaperConfig
     from pftrack.tracking import TrackerConfig, track_frames
@@ -175,11 +184,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         p.error("--hold-frames needs --detector paper (the hold is the built-in detector's)")
     grey = {
         k: v
-        for k, v in (("grey_t_min", args.grey_t_min), ("grey_shadow_lo", args.grey_shadow_lo))
+        for k, v in (
+            ("grey_t_min", args.grey_t_min),
+            ("grey_shadow_lo", args.grey_shadow_lo),
+            ("grey_texture", args.grey_texture),
+            ("grey_texture_window", args.grey_texture_window),
+            ("grey_texture_erode", args.grey_texture_erode),
+        )
         if v is not None
     }
     if grey and args.detector != "paper":
-        p.error("--grey-t-min and --grey-shadow-lo need --detector paper")
+        p.error("--grey-t-min, --grey-shadow-lo and --grey-texture* need --detector paper")
     try:
         detector: str | PaperConfig = PaperConfig(**grey) if grey else args.detector
     except ValueError as e:

@@ -63,6 +63,9 @@ def test_grey_settings_reach_the_detector_and_are_printed(
     assert seen[0] == "paper"  # unchanged unless asked
     assert (seen[1].grey_t_min, seen[1].grey_shadow_lo, seen[1].t_min) == (20.0, 0.8, 25.0)
     assert "detector=paper grey_t_min=20 grey_shadow_lo=0.8 " in capsys.readouterr().out
+    detector_robustness.main([*args, "--grey-texture", "0.7", "--grey-texture-erode", "3"])
+    assert (seen[2].grey_texture, seen[2].grey_texture_erode) == (0.7, 3)
+    assert "detector=paper grey_texture=0.7 grey_texture_erode=3 " in capsys.readouterr().out
 
 
 @pytest.mark.parametrize(
@@ -70,7 +73,9 @@ def test_grey_settings_reach_the_detector_and_are_printed(
     [
         (["--grey-t-min", "70"], "grey_t_min is 70.0, expected None or in [0, t_max]"),
         (["--grey-shadow-lo", "2"], "grey_shadow_lo is 2.0, expected in [0, 1]"),
-        (["--grey-t-min", "9", "--detector", "knn"], "--grey-t-min and --grey-shadow-lo need"),
+        (["--grey-t-min", "9", "--detector", "knn"], "--grey-t-min, --grey-shadow-lo and --grey"),
+        (["--grey-texture", "2"], "grey_texture is 2.0, expected in [0, 1] (0: off)"),
+        (["--grey-texture-window", "4"], "grey_texture_window is 4, expected an odd number"),
     ],
 )
 def test_bad_grey_settings_are_one_line(

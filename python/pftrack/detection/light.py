@@ -23,6 +23,11 @@ Two rules of `PaperDetector` (docs/detection.md, "Grey video and changing light"
   the grey-level thresholds by the gain accumulated since the first frame
   (``BackgroundModel.set_threshold_scale``). :func:`level_frames` brings the priming frames
   to one brightness before their median.
+* **Texture on grey video** (``PaperConfig.grey_texture``, off: docs/detection.md, "Stop
+  68"). A grey pixel differs from the background by ``|Y - Y_B|`` only, and people of the
+  ground's brightness come apart in pieces. :func:`texture_changed` marks where the frame's
+  local pattern no longer correlates with the background's (a person hides the ground's
+  texture), which a shadow or a change of light (a gain) leaves correlated.
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ import math
 from collections.abc import Iterable
 from typing import Any
 
+import cv2
 import numpy as np
 from numpy.typing import NDArray
 
@@ -52,6 +58,7 @@ __all__ = [
     "level_frames",
     "looks_grey",
     "sample_step",
+    "texture_changed",
 ]
 
 GREY_SAMPLE_STEP = 4
@@ -324,3 +331,59 @@ def levelled_median(frames: list[NDArray[np.uint8]], band: float, fn: str) -> ND
         sub = median[rows]  # a view: written into the median, never below its bound
         sub[kept] = np.maximum(sub[kept], np.nanmedian(stack[:, kept], axis=0))
     return median
+
+
+def texture_changed(
+    grey: NDArray[np.uint8],
+    background: NDArray[np.float32],
+    ncc_max: float,
+    window: int = 5,
+    erode: int = 5,
+    min_variance: float = 25.0,
+) -> NDArray[np.bool_]:
+    """Where a grey frame's local pattern does not correlate with its background's.
+
+    The normalised cross-correlation of the frame and the background over the `window` x
+    `window` box around each pixel (borders reflected, OpenCV's ``boxFilter``) is below
+    `ncc_max` where either box's variance is above `min_variance` (grey levels squared: 25 is
+    a standard deviation of 5; flat boxes, of noise alone, tell nothing), and that set is
+    eroded by an `erode` x `erode` square (0 or 1: not at all), which takes back the band of
+    about half a window by which a changed box reaches past a person's outline. A gain (a
+    shadow, a change of light) leaves the correlation at 1.
+
+    Parameters
+    ----------
+    grey : (H, W) uint8 ndarray
+        The frame's grey level.
+    background : (H, W) float32 ndarray
+        The background's grey level.
+    ncc_max : float
+        The correlation below which a pixel's box has changed, in (-1, 1].
+    window, erode : int
+        Box side (odd, >= 3) and erosion side (>= 0).
+    min_variance : float
+        The variance one of the two boxes needs for its correlation to count.
+
+    Returns
+    -------
+    (H, W) bool ndarray
+    """
+    # centred on mid-grey: the boxes' sums of products stay small, so float32 rounding stays
+    # far below the variance floor of 1 (a flat box, a saturated one, is then exactly "no
+    # correlation" against a textured one, not rounding noise)
+    i = np.asarray(grey, np.float32) - 128.0
+    b = np.asarray(background, np.float32) - 128.0
+    size = (window, window)
+    mi = cv2.boxFilter(i, -1, size)
+    mb = cv2.boxFilter(b, -1, size)
+    vi = cv2.boxFilter(i * i, -1, size) - mi * mi
+    vb = cv2.boxFilter(b * b, -1, size) - mb * mb
+    cov = cv2.boxFilter(i * b, -1, size) - mi * mb
+    # cov < ncc_max sqrt(vi vb), without a division (variances floored at 1 grey level squared)
+    changed: NDArray[np.bool_] = (
+        cov < ncc_max * np.sqrt(np.maximum(vi, 1.0) * np.maximum(vb, 1.0))
+    ) & (np.maximum(vi, vb) > min_variance)
+    if erode > 1:
+        out = cv2.erode(changed.view(np.uint8), np.ones((erode, erode), np.uint8))
+        changed = np.asarray(out, np.bool_)
+    return changed
