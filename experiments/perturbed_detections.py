@@ -396,7 +396,8 @@ def main(argv: list[str] | None = None) -> int:
         for n in notes:
             print(f"- {n}")
         print(head, flush=True)
-        for si, name in enumerate(args.seq):
+        for name in args.seq:
+            si = NAMES.index(name)  # the same draw whichever sequences are run
             base = load_sequence(data, name)
             for ci, kind in enumerate(COPIES):
                 if kind not in args.copies:
@@ -410,7 +411,10 @@ def main(argv: list[str] | None = None) -> int:
                     lines.append(line(kind, name, tracker, s))
                     print(lines[-1], flush=True)
         print()
-        summary = ["| copy | tracker | mean MOTA | mean IDF1 | mean HOTA |", "|---|---|---|---|---|"]
+        summary = [
+            "| copy | tracker | mean MOTA | mean IDF1 | mean HOTA |",
+            "|---|---|---|---|---|",
+        ]
         for kind in [k for k in COPIES if k in args.copies] + ["perturbed"]:
             for tracker in trackers:
                 if kind == "perturbed":
