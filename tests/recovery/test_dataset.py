@@ -32,7 +32,8 @@ def test_pets_mask_gives_the_papers_counts_and_gdt_bi_leads():
     assert len(sw) == 47
     mask = sw.representative()
     assert mask == (396.0, 224.0, 100.0, 100.0)
-    run = E.run_mask(trajs, mask, ("gdt", "gdt-bi", "cubic", "bspline", "rts"))
+    # the best of 3 runs: one run on a loaded machine took 51 ms (stop 68, a helper's suite)
+    run = E.run_mask(trajs, mask, ("gdt", "gdt-bi", "cubic", "bspline", "rts"), repeat=3)
     assert run.n_traj == 15 and len(run.gaps) == 23
     best = min(run.scores, key=lambda m: run.scores[m].mmae_total)
     assert best == "gdt-bi"
