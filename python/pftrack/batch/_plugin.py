@@ -121,10 +121,11 @@ def _exit_at_once() -> None:
     handler of the process, so it runs first. Its worker closed cleanly (its teardown ran):
     its tasks are over, its local directory removed (Dask's ``Server.close``), and a worker
     writes no file. What is left is the interpreter's teardown (the other exit handlers, every
-    module and object freed one by one): 0.65-1.03 s of the local cluster's close and 0.13-0.2
-    CPU-seconds per worker (two workers, 3 runs each alternated at load 15, stop 68), which
-    ``pftrack batch`` waited for; a ``forkserver``'s workers end so already
-    (``os._exit`` after their target). Its logs and streams are flushed first.
+    module and object freed one by one), which ``pftrack batch`` waited for: the close of a
+    two-worker local cluster took 0.47-0.80 s with it and 0.04 s without, and each worker
+    0.12-0.15 CPU-seconds more (3 runs alternated against main's install at load 10, stop 68,
+    docs/batch.md). A ``forkserver``'s workers end so already (``os._exit`` after their
+    target). Its logs and streams are flushed first.
     """
     logging.shutdown()
     for stream in (sys.stdout, sys.stderr):
