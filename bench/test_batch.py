@@ -17,12 +17,19 @@ nice pytest bench/test_batch.py --benchmark-enable --benchmark-only --benchmark-
 - ``batch memory``: 100 tiny sequences on the two workers; each worker's resident memory after
   the first 10 and after all 100 (goal: flat).
 
-Figures go to ``extra_info`` and are printed (``-s``).
+Figures go to ``extra_info`` and are printed (``-s``). Beside each four-sequence case's wall and
+each task's ``cpu_seconds`` (its ``process_time``), the CPU of whole processes over the run
+(``getrusage``, every thread): this process (the serial run's read-ahead and detector threads;
+a cluster's scheduler, nannies and client), and the workers' processes (``client.run`` on a
+warm cluster; the reaped children of a cluster started and closed inside the run, their start
+included), with the cores they kept busy (CPU / wall): the serial run's is the bound of the
+speed-up on two cores (stop 68, docs/batch.md).
 """
 
 from __future__ import annotations
 
 import os
+import resource
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -95,15 +102,40 @@ def tiny(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return folder
 
 
+def _process_cpu(who: int = resource.RUSAGE_SELF) -> float:
+    """User and system CPU seconds of this process (all its threads), or of its reaped children."""
+    used = resource.getrusage(who)
+    return used.ru_utime + used.ru_stime
+
+
+def _workers_cpu(client: Any) -> float:
+    """The CPU seconds the client's workers' processes have used so far, summed."""
+    return float(sum(client.run(_process_cpu).values()))
+
+
 def _run(inputs: Any, out: Path, client: Any = None, **kwargs: Any) -> float:
+    workers = _workers_cpu(client) if client is not None else 0.0
+    here, children = _process_cpu(), _process_cpu(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     summary = track_many(inputs, out, client, force=True, show_progress=False, **kwargs)
+    seconds = time.perf_counter() - start
     assert not summary.failed, summary.table()
     CPU[str(out)] = [e["cpu_seconds"] for e in summary.entries]
-    return time.perf_counter() - start
+    # the processes' CPU, all threads: a serial run's read-ahead and detector threads, a
+    # worker's Dask threads, a started cluster's imports (its workers are this process's
+    # children, reaped when it closes); `cpu_seconds` above is each task's process_time
+    used = {"this process": _process_cpu() - here}
+    if client is not None:
+        used["workers"] = _workers_cpu(client) - workers
+    elif kwargs.get("n_workers", 1) != 0:
+        used["workers"] = _process_cpu(resource.RUSAGE_CHILDREN) - children
+    PROCESS_CPU[str(out)] = used
+    return seconds
 
 
 CPU: dict[str, list[float]] = {}  # CPU seconds of each sequence's task, by output folder
+#: CPU seconds of this process and of the workers' processes over a run, by output folder
+PROCESS_CPU: dict[str, dict[str, float]] = {}
 
 
 TIMES: dict[str, float] = {}  # the serial time, for the speed-up printed by the next case
@@ -116,12 +148,24 @@ def _timed(benchmark: BenchmarkFixture, key: str, *args: Any, **kwargs: Any) -> 
     seconds = float(benchmark.pedantic(_run, args, kwargs, rounds=1))
     TIMES[key] = seconds
     cpu = CPU[str(args[1])]
+    used = PROCESS_CPU[str(args[1])]
     load = os.getloadavg()[0]  # the other users of the cores, for reading the figures
+    total = sum(used.values())
     benchmark.extra_info.update(
-        seconds=seconds, cpu_seconds_per_sequence=cpu, loadavg=load, video=video
+        seconds=seconds,
+        cpu_seconds_per_sequence=cpu,
+        process_cpu_seconds=used,
+        cores_busy=total / seconds,
+        loadavg=load,
+        video=video,
     )
     line = f"\n{key} ({video}): {seconds:.1f} s (load {load:.1f}); CPU s per sequence " + " ".join(
         f"{c:.2f}" for c in cpu
+    )
+    line += (
+        "; processes' CPU "
+        + ", ".join(f"{who} {c:.2f} s" for who, c in used.items())
+        + f" = {total / len(cpu):.2f} s per sequence, {total / seconds:.2f} cores busy"
     )
     if key != "serial" and "serial" in TIMES:
         benchmark.extra_info["speedup"] = TIMES["serial"] / seconds
