@@ -139,13 +139,25 @@ def test_a_signal_during_the_renames_is_raised_after_the_last(
     Was: the ``KeyboardInterrupt`` raised after the first rename left ``a.txt`` new beside an old
     ``b.png`` and ``c.json`` (``pftrack demo``'s five files, a real Ctrl-C).
     """
-    from pftrack.cli._signals import sigterm_raises
-    from pftrack.io.atomic import staged_outputs
-
     names = ["a.txt", "b.png", "c.json"]
     for name in names:
         (tmp_path / name).write_text(f"old {name}")
     signum = getattr(signal, signame)
+    # Python's own SIGINT handler, as in a shell's foreground: a suite started with `&` or
+    # nohup starts with SIGINT ignored, and a deferred SIGINT then stays ignored (as it should)
+    started = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        _raised_after_the_last(tmp_path, monkeypatch, names, signum, sender)
+    finally:
+        signal.signal(signal.SIGINT, started)
+
+
+def _raised_after_the_last(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, names: list[str], signum: int, sender: str
+) -> None:
+    from pftrack.cli._signals import sigterm_raises
+    from pftrack.io.atomic import staged_outputs
+
     renamed = _signalled_after_the_first_rename(monkeypatch, signum, sender)
     committed: list[list[str]] = []
     with pytest.raises(KeyboardInterrupt), sigterm_raises():
