@@ -297,7 +297,7 @@ def run(args: argparse.Namespace) -> int:
         evaluate_sequence,
         format_scores,
         scores_csv,
-        scores_json,
+        scores_doc,
     )
     from pftrack.io.atomic import check_output, check_replaceable, staged_outputs
     from pftrack.io.marks import is_marked_csv, is_marked_json, json_marked
@@ -394,7 +394,7 @@ def run(args: argparse.Namespace) -> int:
             if Path(args.gt).is_file():  # one file: its metrics at the top level, as before
                 doc = next(iter(scores.values())).as_dict()
             else:
-                doc = json.loads(scores_json(scores, combined))
+                doc = scores_doc(scores, combined)
             text = json.dumps(json_marked(doc, "eval"), indent=2)
             with stage(args.json, ".json").open("w") as fh:
                 fh.write(text + "\n")

@@ -45,6 +45,7 @@ __all__ = [
     "read_seqinfo",
     "result_file",
     "scores_csv",
+    "scores_doc",
     "scores_json",
     "seqmap_of",
 ]
@@ -686,16 +687,23 @@ def format_scores(
     return "\n".join(lines)
 
 
-def scores_json(rows: Mapping[str, SequenceScores], combined: SequenceScores | None) -> str:
-    """JSON text: ``{"sequences": {name: scores}, "combined": scores}`` (NaN as null).
+def scores_doc(
+    rows: Mapping[str, SequenceScores], combined: SequenceScores | None, *, fn: str = "scores_doc"
+) -> dict[str, object]:
+    """``{"sequences": {name: scores}, "combined": scores}``, what :func:`scores_json` writes.
 
     The combined scores' ``success_per_object`` is ``[]``: per-object rates are per sequence.
     """
-    _named_scores("scores_json", rows, combined)
+    _named_scores(fn, rows, combined)
     doc: dict[str, object] = {"sequences": {k: v.as_dict() for k, v in rows.items()}}
     if combined is not None:
         doc["combined"] = combined.as_dict()
-    return json.dumps(doc, indent=2)
+    return doc
+
+
+def scores_json(rows: Mapping[str, SequenceScores], combined: SequenceScores | None) -> str:
+    """JSON text of :func:`scores_doc` (NaN as null)."""
+    return json.dumps(scores_doc(rows, combined, fn="scores_json"), indent=2)
 
 
 def scores_csv(rows: Mapping[str, SequenceScores], combined: SequenceScores | None) -> str:
