@@ -675,6 +675,8 @@ def report_stream(*outputs: str | None) -> Any:
 #: What a file an output option would replace may be, for the message of
 #: :func:`~pftrack.io.atomic.check_replaceable` (a picture, a JSON or CSV file: the user's).
 YOURS = "pftrack did not write (a file of yours?)"
+#: The same for a tracks ``--out``: a file that holds no MOTChallenge rows.
+TRACKS_YOURS = "holds no MOTChallenge rows (a file of yours?)"
 
 
 def add_force(parser: argparse.ArgumentParser) -> None:
@@ -684,7 +686,3 @@ def add_force(parser: argparse.ArgumentParser) -> None:
         help="replace an existing output file that pftrack did not write (default: refused, "
         "exit 2; absent, empty and pftrack's own files are always replaced)",
     )  # fmt: skip
-
-
-#: The same for a tracks ``--out``: a file that holds no MOTChallenge rows.
-TRACKS_YOURS = "holds no MOTChallenge rows (a file of yours?)"
