@@ -11,20 +11,27 @@ import pftrack.tracking
 from experiments import detector_robustness
 
 
-def test_hold_frames_reaches_the_tracker_and_is_printed(
-    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    seen: list[int] = []
+@pytest.fixture
+def configs(monkeypatch: pytest.MonkeyPatch) -> list[Any]:
+    """The config of each ``track_frames`` call the experiment makes, on 12 frames of each."""
+    seen: list[Any] = []
     real = pftrack.tracking.track_frames
 
     def first_frames(source: Any, config: Any, **kw: Any) -> Any:
-        seen.append(config.hold_frames)
+        seen.append(config)
         return real(source[:12], config=config, **kw)  # 12 frames are enough to run
 
     monkeypatch.setattr(pftrack.tracking, "track_frames", first_frames)
+    return seen
+
+
+def test_hold_frames_reaches_the_tracker_and_is_printed(
+    configs: list[Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     for hold in (None, 7):
         args = ["--sequences", "walkers", "--variants", "ident", "--out", str(tmp_path)]
         detector_robustness.main(args + ([] if hold is None else ["--hold-frames", str(hold)]))
+    seen = [c.hold_frames for c in configs]
     assert seen == [0, 7]  # off unless asked, as TrackerConfig's default
     out = capsys.readouterr().out
     assert "hold_frames=0 " in out and "hold_frames=7 " in out
@@ -47,23 +54,17 @@ def test_bad_hold_frames_is_one_line(
 
 
 def test_grey_settings_reach_the_detector_and_are_printed(
-    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    configs: list[Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    seen: list[Any] = []
-    real = pftrack.tracking.track_frames
-
-    def first_frames(source: Any, config: Any, **kw: Any) -> Any:
-        seen.append(config.detector)
-        return real(source[:12], config=config, **kw)
-
-    monkeypatch.setattr(pftrack.tracking, "track_frames", first_frames)
     args = ["--sequences", "walkers", "--variants", "ident", "--out", str(tmp_path)]
     detector_robustness.main(args)
     detector_robustness.main([*args, "--grey-t-min", "20", "--grey-shadow-lo", "0.8"])
+    seen = [c.detector for c in configs]
     assert seen[0] == "paper"  # unchanged unless asked
     assert (seen[1].grey_t_min, seen[1].grey_shadow_lo, seen[1].t_min) == (20.0, 0.8, 25.0)
     assert "detector=paper grey_t_min=20 grey_shadow_lo=0.8 " in capsys.readouterr().out
     detector_robustness.main([*args, "--grey-texture", "0.7", "--grey-texture-erode", "3"])
+    seen = [c.detector for c in configs]
     assert (seen[2].grey_texture, seen[2].grey_texture_erode) == (0.7, 3)
     assert "detector=paper grey_texture=0.7 grey_texture_erode=3 " in capsys.readouterr().out
 
