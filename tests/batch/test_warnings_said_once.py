@@ -97,12 +97,13 @@ def test_the_command_says_a_repeated_warning_in_one_short_line(
 
 def test_many_sequences_each_with_its_own_warning_are_listed_at_once() -> None:
     """Each pair of messages was matched by a pattern built for it: 1000 sequences, each
-    with its own warning, took 37 s to list (0.2 s now; 5 s allowed for a loaded machine)."""
+    with its own warning, took 37 s to list (0.2 s now; 5 s allowed). Timed in CPU seconds
+    of this process: at load 25 the wall clock reached 5.1 s."""
     own = [(f"cam{k:04d}", f"frame {7 * k}: {k % 5} boxes outside the frame") for k in range(1000)]
     named = [(f"v{k:04d}", f"/in/v{k:04d}.avi: ended after {k} frames") for k in range(1000)]
-    started = time.perf_counter()
+    started = time.process_time()
     assert said_alike(own) == [(m, [n]) for n, m in own]
     assert said_alike(named) == [(m, [n]) for n, m in named]
     before = SaidBefore()
     assert all(before.first(n, m) is None for n, m in own + named)
-    assert time.perf_counter() - started < 5.0
+    assert time.process_time() - started < 5.0
