@@ -406,7 +406,7 @@ _NO_FRAMES = (
 
 def _tracks_in(entries: list[Path]) -> tuple[list[str], list[Path]]:
     """The ``.txt`` files among a folder's `entries`, and its folders (not links to them)."""
-    names = [e.name for e in entries if e.suffix == ".txt" and e.is_file()]
+    names = [e.name for e in entries if e.suffix.lower() == ".txt" and e.is_file()]
     return names, [e for e in entries if e.is_dir() and not e.is_symlink()]
 
 
@@ -558,7 +558,8 @@ def find_track_files(inputs: Inputs) -> list[Path]:
             (
                 p
                 for p in path.iterdir()
-                if (p.is_file() or _broken_link(p)) and p.suffix == ".txt"  # broken: its task fails
+                # broken: its task fails; .TXT too (was: passed over without a word, a user trial)
+                if (p.is_file() or _broken_link(p)) and p.suffix.lower() == ".txt"
             ),
             key=_listing_key,
         )
