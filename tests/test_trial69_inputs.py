@@ -41,3 +41,30 @@ def test_one_name_in_two_cases_is_refused(tmp_path, capsys):
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "two inputs are both named 'a'" in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("name", ["gt.txt", "tracks.csv", "det"])
+def test_batch_refuses_a_tracks_file_before_work(tmp_path, capsys, name):
+    """Was: a task that failed as "not a video", exit 1, ``--out`` made with a summary."""
+    path = tmp_path / name
+    write_mot(path, ROWS)
+    out = tmp_path / "out"
+    assert main(["batch", "-q", str(path), "--out", str(out), "--workers", "0"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1
+    assert f"{path} holds MOTChallenge rows (tracks or detections), not frames" in err
+    assert "pftrack recover or pftrack smooth take tracks files" in err
+    assert not out.exists()
+
+
+def test_batch_still_runs_an_empty_or_binary_file_as_a_failed_task(tmp_path, capsys):
+    """Not rows: a damaged video as far as the batch can tell (its task fails, exit 1)."""
+    empty = tmp_path / "empty.txt"
+    empty.touch()
+    binary = tmp_path / "junk.dat"
+    binary.write_bytes(b"\xff\x00" * 100)
+    for path in (empty, binary):
+        out = tmp_path / f"out_{path.stem}"
+        assert main(["batch", "-q", str(path), "--out", str(out), "--workers", "0"]) == 1
+        assert (out / "summary.json").is_file()
+    capsys.readouterr()

@@ -267,6 +267,27 @@ def _within(name: str, frames: Path, ini: Path) -> SequenceInput:
     return SequenceInput(name, frames, *annotations, info.width, info.height, seqinfo=ini)
 
 
+def _refuse_tracks_file(path: Path) -> None:
+    """Refuse a file of MOTChallenge rows given as a sequence, before any work.
+
+    ``pftrack batch gt.txt`` (a tracks file meant for ``recover`` or ``smooth``) was a task
+    that failed as "not a video", exit 1, after the batch had started and made ``--out``.
+    """
+    from pftrack.io.marks import is_mot_text
+
+    if (
+        path.is_file()
+        and path.suffix.lower() not in VIDEO_SUFFIXES
+        and path.stat().st_size > 0
+        and is_mot_text(path)
+    ):
+        raise ValueError(
+            f"{path} holds MOTChallenge rows (tracks or detections), not frames: pftrack batch "
+            "tracks videos, image folders and sequence folders; pftrack recover or pftrack "
+            "smooth take tracks files"
+        )
+
+
 def _readable_as_sequence(path: Path) -> SequenceInput | None:
     """:func:`_as_sequence`, or a sequence whose task fails for a folder it cannot look into.
 
@@ -461,6 +482,7 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
     for path in paths:
         _check_exists(path)
         _refuse_special(path, " (pftrack track reads a pipe live, alone)")
+        _refuse_tracks_file(path)
         seq = _readable_as_sequence(path)
         if seq is not None:
             found.append(seq)
