@@ -267,6 +267,27 @@ def _within(name: str, frames: Path, ini: Path) -> SequenceInput:
     return SequenceInput(name, frames, *annotations, info.width, info.height, seqinfo=ini)
 
 
+def _refuse_tracks_file(path: Path) -> None:
+    """Refuse a file of MOTChallenge rows given as a sequence, before any work.
+
+    ``pftrack batch gt.txt`` (a tracks file meant for ``recover`` or ``smooth``) was a task
+    that failed as "not a video", exit 1, after the batch had started and made ``--out``.
+    """
+    from pftrack.io.marks import is_mot_text
+
+    if (
+        path.is_file()
+        and path.suffix.lower() not in VIDEO_SUFFIXES
+        and path.stat().st_size > 0
+        and is_mot_text(path)
+    ):
+        raise ValueError(
+            f"{path} holds MOTChallenge rows (tracks or detections), not frames: pftrack batch "
+            "tracks videos, image folders and sequence folders; pftrack recover or pftrack "
+            "smooth take tracks files"
+        )
+
+
 def _readable_as_sequence(path: Path) -> SequenceInput | None:
     """:func:`_as_sequence`, or a sequence whose task fails for a folder it cannot look into.
 
@@ -406,7 +427,7 @@ _NO_FRAMES = (
 
 def _tracks_in(entries: list[Path]) -> tuple[list[str], list[Path]]:
     """The ``.txt`` files among a folder's `entries`, and its folders (not links to them)."""
-    names = [e.name for e in entries if e.suffix == ".txt" and e.is_file()]
+    names = [e.name for e in entries if e.suffix.lower() == ".txt" and e.is_file()]
     return names, [e for e in entries if e.is_dir() and not e.is_symlink()]
 
 
@@ -461,6 +482,7 @@ def find_sequences(inputs: Inputs) -> list[SequenceInput]:
     for path in paths:
         _check_exists(path)
         _refuse_special(path, " (pftrack track reads a pipe live, alone)")
+        _refuse_tracks_file(path)
         seq = _readable_as_sequence(path)
         if seq is not None:
             found.append(seq)
@@ -558,7 +580,8 @@ def find_track_files(inputs: Inputs) -> list[Path]:
             (
                 p
                 for p in path.iterdir()
-                if (p.is_file() or _broken_link(p)) and p.suffix == ".txt"  # broken: its task fails
+                # broken: its task fails; .TXT too (was: passed over without a word, a user trial)
+                if (p.is_file() or _broken_link(p)) and p.suffix.lower() == ".txt"
             ),
             key=_listing_key,
         )
