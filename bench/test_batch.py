@@ -113,8 +113,48 @@ def _workers_cpu(client: Any) -> float:
     return float(sum(client.run(_process_cpu).values()))
 
 
+def _task_threads_cpu() -> dict[int, float]:
+    """CPU seconds of each of this Dask worker's task threads (its default executor's), by id.
+
+    The rest of a worker's process is Dask's (its event loop, heartbeats, the offload thread):
+    what a worker spends that a plain process tracking on one thread does not (stop 69).
+    """
+    import threading
+
+    used = {}
+    for thread in threading.enumerate():
+        if "Dask-Default-Threads" in thread.name and thread.ident is not None:
+            try:
+                clock = time.pthread_getcpuclockid(thread.ident)
+                used[thread.ident] = time.clock_gettime(clock)
+            except OSError:  # ended meanwhile
+                continue
+    return used
+
+
+def _workers_task_cpu(client: Any) -> dict[str, dict[int, float]]:
+    """:func:`_task_threads_cpu` of each of the client's workers, by address."""
+    return dict(client.run(_task_threads_cpu))
+
+
+def _task_cpu_spent(
+    before: dict[str, dict[int, float]], after: dict[str, dict[int, float]]
+) -> float:
+    """CPU seconds the workers' task threads spent between two :func:`_workers_task_cpu`.
+
+    A thread started meanwhile counts from 0; one that ended meanwhile (Dask ends a task thread
+    idle for a while) is not counted here, so its CPU falls to the rest of its process.
+    """
+    return sum(
+        used - before.get(worker, {}).get(ident, 0.0)
+        for worker, threads in after.items()
+        for ident, used in threads.items()
+    )
+
+
 def _run(inputs: Any, out: Path, client: Any = None, **kwargs: Any) -> float:
     workers = _workers_cpu(client) if client is not None else 0.0
+    tasks = _workers_task_cpu(client) if client is not None else {}
     here, children = _process_cpu(), _process_cpu(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     summary = track_many(inputs, out, client, force=True, show_progress=False, **kwargs)
@@ -127,6 +167,7 @@ def _run(inputs: Any, out: Path, client: Any = None, **kwargs: Any) -> float:
     used = {"this process": _process_cpu() - here}
     if client is not None:
         used["workers"] = _workers_cpu(client) - workers
+        TASK_THREADS_CPU[str(out)] = _task_cpu_spent(tasks, _workers_task_cpu(client))
     elif kwargs.get("n_workers", 1) != 0:
         used["workers"] = _process_cpu(resource.RUSAGE_CHILDREN) - children
     PROCESS_CPU[str(out)] = used
@@ -136,6 +177,9 @@ def _run(inputs: Any, out: Path, client: Any = None, **kwargs: Any) -> float:
 CPU: dict[str, list[float]] = {}  # CPU seconds of each sequence's task, by output folder
 #: CPU seconds of this process and of the workers' processes over a run, by output folder
 PROCESS_CPU: dict[str, dict[str, float]] = {}
+#: CPU seconds of the warm workers' task threads over a run (the rest of `PROCESS_CPU`'s
+#: "workers" is Dask's own threads), by output folder
+TASK_THREADS_CPU: dict[str, float] = {}
 
 
 TIMES: dict[str, float] = {}  # the serial time, for the speed-up printed by the next case
@@ -167,6 +211,13 @@ def _timed(benchmark: BenchmarkFixture, key: str, *args: Any, **kwargs: Any) -> 
         + ", ".join(f"{who} {c:.2f} s" for who, c in used.items())
         + f" = {total / len(cpu):.2f} s per sequence, {total / seconds:.2f} cores busy"
     )
+    if str(args[1]) in TASK_THREADS_CPU:  # a warm cluster: the workers' CPU, task threads or not
+        threads = TASK_THREADS_CPU[str(args[1])]
+        benchmark.extra_info["workers_task_threads_cpu_seconds"] = threads
+        line += (
+            f"; workers' task threads {threads:.2f} s, the rest of the workers "
+            f"{used['workers'] - threads:.2f} s"
+        )
     if key != "serial" and "serial" in TIMES:
         benchmark.extra_info["speedup"] = TIMES["serial"] / seconds
         line += f"; {TIMES['serial'] / seconds:.2f}x serial"
