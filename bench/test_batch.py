@@ -23,7 +23,9 @@ each task's ``cpu_seconds`` (its ``process_time``), the CPU of whole processes o
 a cluster's scheduler, nannies and client), and the workers' processes (``client.run`` on a
 warm cluster; the reaped children of a cluster started and closed inside the run, their start
 included), with the cores they kept busy (CPU / wall): the serial run's is the bound of the
-speed-up on two cores (stop 68, docs/batch.md).
+speed-up on two cores (stop 68, docs/batch.md). On the warm cluster, the workers' CPU is split
+into their task threads' (the tracking) and the rest of their processes' (Dask's event loop,
+heartbeats: what a worker spends beyond a plain process tracking on one thread; stop 69).
 """
 
 from __future__ import annotations
