@@ -12,7 +12,7 @@ nice pytest bench/test_batch.py --benchmark-enable --benchmark-only --benchmark-
   whether two workers of three threads on two cores cost less CPU than of one is stop 68's and
   69's open lead); and once more including the cluster's start and close, as ``pftrack batch``
   does it. Goal: serial / two workers >= 1.7 on two cores. Untimed
-  (``--benchmark-disable``, as CI runs the benchmarks as tests) the three cases take the smallest
+  (``--benchmark-disable``, as CI runs the benchmarks as tests) the four cases take the smallest
   input that still runs the same path, four links to a synthetic 160x120 video of 8 frames (they
   took 27 % of CI's bench step on PETS09's 795 frames); ``extra_info["video"]`` says so.
 - ``batch overhead``: 40 tiny sequences (3 frames of 64x64): the scheduler's cost per sequence,
@@ -126,7 +126,7 @@ def _task_threads_cpu() -> dict[int, float]:
     """
     import threading
 
-    used = {}
+    used: dict[int, float] = {}
     for thread in threading.enumerate():
         if "Dask-Default-Threads" in thread.name and thread.ident is not None:
             try:
