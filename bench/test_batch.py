@@ -27,8 +27,9 @@ a cluster's scheduler, nannies and client), and the workers' processes (``client
 warm cluster; the reaped children of a cluster started and closed inside the run, their start
 included), with the cores they kept busy (CPU / wall): the serial run's is the bound of the
 speed-up on two cores (stop 68, docs/batch.md). On the warm cluster, the workers' CPU is split
-into their task threads' (the tracking) and the rest of their processes' (Dask's event loop,
-heartbeats: what a worker spends beyond a plain process tracking on one thread; stop 69).
+into their task threads' (the tracking) and their other threads' (Dask's event loop,
+heartbeats: what a worker spends beyond a plain process tracking on one thread; stop 69; and
+the pipeline's read-ahead and detector threads in the case that switches them on).
 """
 
 from __future__ import annotations
@@ -220,7 +221,7 @@ def _timed(benchmark: BenchmarkFixture, key: str, *args: Any, **kwargs: Any) -> 
         threads = TASK_THREADS_CPU[str(args[1])]
         benchmark.extra_info["workers_task_threads_cpu_seconds"] = threads
         line += (
-            f"; workers' task threads {threads:.2f} s, the rest of the workers "
+            f"; workers' task threads {threads:.2f} s, their other threads "
             f"{used['workers'] - threads:.2f} s"
         )
     if key != "serial" and "serial" in TIMES:
