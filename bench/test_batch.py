@@ -7,9 +7,12 @@ nice pytest bench/test_batch.py --benchmark-enable --benchmark-only --benchmark-
   ends in ``[synthetic scene]`` and ``extra_info["video"]`` says why) tracked with
   ``pftrack track``'s defaults, one after the other in this process (``n_workers=0``, OpenCV
   at one thread as ``pftrack track`` and ``pftrack batch --workers 0`` set it) and on a warm
-  two-worker ``LocalCluster``; and once more including the cluster's start and close, as
-  ``pftrack batch`` does it. Goal: serial / two workers >= 1.7 on two cores. Untimed
-  (``--benchmark-disable``, as CI runs the benchmarks as tests) the three cases take the smallest
+  two-worker ``LocalCluster``; on that cluster again with each worker's read-ahead, detector
+  and kernel threads switched on (``PFTRACK_TRACKING_THREADS=1``: the plugin switches them off;
+  whether two workers of three threads on two cores cost less CPU than of one is stop 68's and
+  69's open lead); and once more including the cluster's start and close, as ``pftrack batch``
+  does it. Goal: serial / two workers >= 1.7 on two cores. Untimed
+  (``--benchmark-disable``, as CI runs the benchmarks as tests) the four cases take the smallest
   input that still runs the same path, four links to a synthetic 160x120 video of 8 frames (they
   took 27 % of CI's bench step on PETS09's 795 frames); ``extra_info["video"]`` says so.
 - ``batch overhead``: 40 tiny sequences (3 frames of 64x64): the scheduler's cost per sequence,
@@ -23,7 +26,10 @@ each task's ``cpu_seconds`` (its ``process_time``), the CPU of whole processes o
 a cluster's scheduler, nannies and client), and the workers' processes (``client.run`` on a
 warm cluster; the reaped children of a cluster started and closed inside the run, their start
 included), with the cores they kept busy (CPU / wall): the serial run's is the bound of the
-speed-up on two cores (stop 68, docs/batch.md).
+speed-up on two cores (stop 68, docs/batch.md). On the warm cluster, the workers' CPU is split
+into their task threads' (the tracking) and their other threads' (Dask's event loop,
+heartbeats: what a worker spends beyond a plain process tracking on one thread; stop 69; and
+the pipeline's read-ahead and detector threads in the case that switches them on).
 """
 
 from __future__ import annotations
@@ -113,8 +119,48 @@ def _workers_cpu(client: Any) -> float:
     return float(sum(client.run(_process_cpu).values()))
 
 
+def _task_threads_cpu() -> dict[int, float]:
+    """CPU seconds of each of this Dask worker's task threads (its default executor's), by id.
+
+    The rest of a worker's process is Dask's (its event loop, heartbeats, the offload thread):
+    what a worker spends that a plain process tracking on one thread does not (stop 69).
+    """
+    import threading
+
+    used: dict[int, float] = {}
+    for thread in threading.enumerate():
+        if "Dask-Default-Threads" in thread.name and thread.ident is not None:
+            try:
+                clock = time.pthread_getcpuclockid(thread.ident)
+                used[thread.ident] = time.clock_gettime(clock)
+            except OSError:  # ended meanwhile
+                continue
+    return used
+
+
+def _workers_task_cpu(client: Any) -> dict[str, dict[int, float]]:
+    """:func:`_task_threads_cpu` of each of the client's workers, by address."""
+    return dict(client.run(_task_threads_cpu))
+
+
+def _task_cpu_spent(
+    before: dict[str, dict[int, float]], after: dict[str, dict[int, float]]
+) -> float:
+    """CPU seconds the workers' task threads spent between two :func:`_workers_task_cpu`.
+
+    A thread started meanwhile counts from 0; one that ended meanwhile (Dask ends a task thread
+    idle for a while) is not counted here, so its CPU falls to the rest of its process.
+    """
+    return sum(
+        used - before.get(worker, {}).get(ident, 0.0)
+        for worker, threads in after.items()
+        for ident, used in threads.items()
+    )
+
+
 def _run(inputs: Any, out: Path, client: Any = None, **kwargs: Any) -> float:
     workers = _workers_cpu(client) if client is not None else 0.0
+    tasks = _workers_task_cpu(client) if client is not None else {}
     here, children = _process_cpu(), _process_cpu(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     summary = track_many(inputs, out, client, force=True, show_progress=False, **kwargs)
@@ -127,6 +173,7 @@ def _run(inputs: Any, out: Path, client: Any = None, **kwargs: Any) -> float:
     used = {"this process": _process_cpu() - here}
     if client is not None:
         used["workers"] = _workers_cpu(client) - workers
+        TASK_THREADS_CPU[str(out)] = _task_cpu_spent(tasks, _workers_task_cpu(client))
     elif kwargs.get("n_workers", 1) != 0:
         used["workers"] = _process_cpu(resource.RUSAGE_CHILDREN) - children
     PROCESS_CPU[str(out)] = used
@@ -136,6 +183,9 @@ def _run(inputs: Any, out: Path, client: Any = None, **kwargs: Any) -> float:
 CPU: dict[str, list[float]] = {}  # CPU seconds of each sequence's task, by output folder
 #: CPU seconds of this process and of the workers' processes over a run, by output folder
 PROCESS_CPU: dict[str, dict[str, float]] = {}
+#: CPU seconds of the warm workers' task threads over a run (the rest of `PROCESS_CPU`'s
+#: "workers" is Dask's own threads), by output folder
+TASK_THREADS_CPU: dict[str, float] = {}
 
 
 TIMES: dict[str, float] = {}  # the serial time, for the speed-up printed by the next case
@@ -167,6 +217,13 @@ def _timed(benchmark: BenchmarkFixture, key: str, *args: Any, **kwargs: Any) -> 
         + ", ".join(f"{who} {c:.2f} s" for who, c in used.items())
         + f" = {total / len(cpu):.2f} s per sequence, {total / seconds:.2f} cores busy"
     )
+    if str(args[1]) in TASK_THREADS_CPU:  # a warm cluster: the workers' CPU, task threads or not
+        threads = TASK_THREADS_CPU[str(args[1])]
+        benchmark.extra_info["workers_task_threads_cpu_seconds"] = threads
+        line += (
+            f"; workers' task threads {threads:.2f} s, their other threads "
+            f"{used['workers'] - threads:.2f} s"
+        )
     if key != "serial" and "serial" in TIMES:
         benchmark.extra_info["speedup"] = TIMES["serial"] / seconds
         line += f"; {TIMES['serial'] / seconds:.2f}x serial"
@@ -192,6 +249,27 @@ def test_four_two_workers(
 ) -> None:
     _run([four_sequences / "seq1.avi"], tmp_path, client)  # workers import pftrack: not timed
     _timed(benchmark, "two workers (warm cluster)", four_sequences, tmp_path, client)
+
+
+def _set_worker_threads(value: str) -> None:
+    """Set this worker's ``PFTRACK_TRACKING_THREADS`` (read by each task as it starts)."""
+    from pftrack._threads import WORKER_THREADS_VARIABLE
+
+    os.environ[WORKER_THREADS_VARIABLE] = value
+
+
+@pytest.mark.benchmark(group="batch 4 sequences")
+def test_four_two_workers_pipeline_threads(
+    benchmark: BenchmarkFixture, four_sequences: Path, client: Any, tmp_path: Path
+) -> None:
+    """The warm case with each worker's read-ahead, detector and kernel threads switched on (a
+    worker's plugin switches them off): the lead of stops 68 and 69, on and off in one run."""
+    _run([four_sequences / "seq1.avi"], tmp_path, client)  # workers import pftrack: not timed
+    client.run(_set_worker_threads, "1")
+    try:
+        _timed(benchmark, "two workers, their threads on (warm)", four_sequences, tmp_path, client)
+    finally:
+        client.run(_set_worker_threads, "0")  # as the plugin leaves them, for the later cases
 
 
 @pytest.mark.benchmark(group="batch 4 sequences")
