@@ -36,6 +36,7 @@ import hashlib
 import os
 import time
 from collections.abc import Sequence
+from typing import cast
 
 import numpy as np
 import pytest
@@ -45,6 +46,7 @@ import pftrack
 from experiments import python_share
 from experiments.cost_per_object import new_tracker
 from pftrack._limits import MAX_PARTICLES
+from pftrack._typing import CameraMotion
 from pftrack.tracking.config import CAMERA_MOTION
 
 WARM = 20  # untimed frames: every walker is born and confirmed
@@ -112,7 +114,11 @@ def _update_10_objects(
 
 
 def run_rounds(
-    rounds: int, *, refine: bool = True, particles: int | None = None, camera: str = "auto"
+    rounds: int,
+    *,
+    refine: bool = True,
+    particles: int | None = None,
+    camera: CameraMotion = "auto",
 ) -> list[str]:
     """Run `rounds` fresh trackers over the bench's scene, untimed; each round's rows' md5.
 
@@ -167,7 +173,7 @@ def main(argv: Sequence[str] | None = None) -> None:
                 args.rounds,
                 refine=not args.no_refine,
                 particles=args.particles,
-                camera=args.camera,
+                camera=cast(CameraMotion, args.camera),
             )
         )
     )
