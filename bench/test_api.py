@@ -36,13 +36,18 @@ import hashlib
 import os
 import time
 from collections.abc import Sequence
+from typing import cast
 
 import numpy as np
 import pytest
 from pytest_benchmark.fixture import BenchmarkFixture
 
+import pftrack
 from experiments import python_share
 from experiments.cost_per_object import new_tracker
+from pftrack._limits import MAX_PARTICLES
+from pftrack._typing import CameraMotion
+from pftrack.tracking.config import CAMERA_MOTION
 
 WARM = 20  # untimed frames: every walker is born and confirmed
 GOAL_MS = 0.5  # per frame, 10 objects, beyond the detector
@@ -108,8 +113,19 @@ def _update_10_objects(
     benchmark.extra_info["loadavg"] = round(os.getloadavg()[0], 2)
 
 
-def run_rounds(rounds: int, *, refine: bool = True) -> list[str]:
-    """Run `rounds` fresh trackers over the bench's scene, untimed; each round's rows' md5."""
+def run_rounds(
+    rounds: int,
+    *,
+    refine: bool = True,
+    particles: int | None = None,
+    camera: CameraMotion = "auto",
+) -> list[str]:
+    """Run `rounds` fresh trackers over the bench's scene, untimed; each round's rows' md5.
+
+    `particles` and `camera` are :class:`pftrack.Tracker`'s ``particles`` and
+    ``camera_motion``: options that change the output, counted against the defaults
+    (docs/results.md, "Cost of update at stop 69").
+    """
     import cv2
 
     frames, dets = python_share.scene_dets()
@@ -118,7 +134,12 @@ def run_rounds(rounds: int, *, refine: bool = True) -> list[str]:
     cv2.setNumThreads(1)
     try:
         for _ in range(rounds):
-            tracker = new_tracker(refine=refine)
+            if particles is None and camera == "auto":
+                tracker = new_tracker(refine=refine)
+            else:
+                tracker = pftrack.Tracker(
+                    seed=0, prime=0, refine=refine, particles=particles, camera_motion=camera
+                )
             digest = hashlib.md5()
             for d, f in zip(dets, frames, strict=True):
                 digest.update(tracker.update(d, f).tobytes())
@@ -129,20 +150,37 @@ def run_rounds(rounds: int, *, refine: bool = True) -> list[str]:
 
 
 def main(argv: Sequence[str] | None = None) -> None:
-    """``python -m bench.test_api --rounds R [--no-refine]``: the updates, for an instruction count.
+    """``python -m bench.test_api --rounds R [--no-refine] [--particles N] [--camera off]``.
 
-    Prints the rows' md5 (one, when every round gave the same rows). Bad arguments are one
-    line and exit status 2 (argparse's).
+    The updates, for an instruction count. Prints the rows' md5 (one, when every round gave
+    the same rows). Bad arguments are one line and exit status 2 (argparse's).
     """
     p = argparse.ArgumentParser(description="Run the bench's updates untimed (see the module).")
     p.add_argument("--rounds", type=int, default=1, help="fresh trackers over the scene (>= 0)")
     p.add_argument("--no-refine", action="store_true", help="box refinement off")
+    p.add_argument(
+        "--particles", type=int, default=None, help="particles per track (default: the tracker's)"
+    )
+    p.add_argument("--camera", choices=CAMERA_MOTION, default="auto", help="camera_motion")
     args = p.parse_args(argv)
     if args.rounds < 0:
         p.error(f"--rounds must be >= 0, got {args.rounds}")
-    digests = sorted(set(run_rounds(args.rounds, refine=not args.no_refine)))
+    if args.particles is not None and not 1 <= args.particles <= MAX_PARTICLES:
+        p.error(f"--particles must be in [1, {MAX_PARTICLES}], got {args.particles}")
+    digests = sorted(
+        set(
+            run_rounds(
+                args.rounds,
+                refine=not args.no_refine,
+                particles=args.particles,
+                camera=cast(CameraMotion, args.camera),
+            )
+        )
+    )
+    options = "" if args.particles is None else f", particles {args.particles}"
+    options += "" if args.camera == "auto" else f", camera {args.camera}"
     print(
-        f"{args.rounds} rounds, refine {'off' if args.no_refine else 'on'}: rows md5 "
+        f"{args.rounds} rounds, refine {'off' if args.no_refine else 'on'}{options}: rows md5 "
         f"{' '.join(digests) or '-'}"
     )
 
@@ -157,6 +195,26 @@ def test_untimed_rounds_give_the_same_rows(capsys: pytest.CaptureFixture[str]) -
         main(["--rounds", "-1"])
     assert exit_.value.code == 2
     assert "--rounds must be >= 0, got -1" in capsys.readouterr().err
+
+
+def test_the_counted_options_are_the_trackers(capsys: pytest.CaptureFixture[str]) -> None:
+    """``--particles`` and ``--camera`` count the tracker with those options, not the default."""
+    default = run_rounds(1, refine=False)
+    fewer = run_rounds(1, refine=False, particles=50, camera="off")
+    assert fewer != default
+    tracker = pftrack.Tracker(seed=0, prime=0, refine=False, particles=50, camera_motion="off")
+    frames, dets = python_share.scene_dets()
+    digest = hashlib.md5()
+    for d, f in zip(dets, frames, strict=True):
+        digest.update(tracker.update(d, f).tobytes())
+    assert fewer == [digest.hexdigest()]
+    main(["--rounds", "0", "--particles", "50", "--camera", "off"])
+    assert capsys.readouterr().out == "0 rounds, refine on, particles 50, camera off: rows md5 -\n"
+    for bad, said in ((["--particles", "0"], "--particles must be in"), (["--camera", "x"], "")):
+        with pytest.raises(SystemExit) as exit_:
+            main(["--rounds", "0", *bad])
+        assert exit_.value.code == 2
+        assert said in capsys.readouterr().err
 
 
 if __name__ == "__main__":
