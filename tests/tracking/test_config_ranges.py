@@ -49,8 +49,6 @@ REFUSED = [
     (LifecycleConfig, "max_coast", 2**31, ValueError, r"integer in \[0, 2147483647\]"),
     (LifecycleConfig, "relink_coast", 0, ValueError, r"integer in \[1, 2147483647\]"),
     (LifecycleConfig, "blind_coast", -1, ValueError, r"integer in \[0, 2147483647\]"),
-    (LifecycleConfig, "miss_window", 0, ValueError, r"integer in \[1, 2147483647\]"),
-    (LifecycleConfig, "miss_window", True, TypeError, r"integer in \[1, 2147483647\], got bool"),
     # was: refused only at run time (5), accepted (NaN, negative)
     (RefineConfig, "fraction", 5.0, ValueError, r"expected a value in \[0, 1\)"),
     (RefineConfig, "fraction", 1.0, ValueError, r"expected a value in \[0, 1\)"),
@@ -83,8 +81,6 @@ def test_a_setting_out_of_range_is_refused_at_construction(cls, name, value, err
         (LifecycleConfig, "relink_coast", None),
         (LifecycleConfig, "blind_coast", None),
         (LifecycleConfig, "blind_coast", 0),
-        (LifecycleConfig, "miss_window", None),
-        (LifecycleConfig, "miss_window", 1),
         (RefineConfig, "fraction", 0.0),
     ],
 )

@@ -323,16 +323,6 @@ class LifecycleConfig:
         does not count: with a detector run every other frame, no track was confirmed before
         (docs/tracking.md, "Lower frame rates and sparse detections"). It still ends after
         `max_coast` frames without a match. At least 0.
-    miss_window : int or None
-        With given detections, let a tentative track miss as often as the detector misses the
-        people already tracked: the confirmed tracks' miss rate ``p`` is measured online over
-        the last `miss_window` frames with detections (the share of confirmed tracks, inside
-        the frame and overlapping no other track, left without a detection), and a tentative
-        track may miss, in all, the misses a person missed at that rate collects on average
-        while it waits for its ``min_hits - 1`` further matches, ``(min_hits - 1) p / (1 - p)``
-        rounded to the nearest count (0 when the detector misses almost nothing), or
-        `tentative_coast` frames in a row if that allows more. None: off (`tentative_coast`
-        alone); else at least 1.
     coast_min_rho : float
         A coasting track is reported only while its colour match ``rho`` stays above this.
     relink_coast : int or None
@@ -436,7 +426,6 @@ class LifecycleConfig:
     min_hits: int = 4
     max_coast: int = 10
     tentative_coast: int = 0
-    miss_window: int | None = None
     coast_min_rho: float = 0.5
     relink_coast: int | None = 7
     nested_inside: float | None = 0.7
@@ -456,8 +445,6 @@ class LifecycleConfig:
             integer(getattr(self, name), f"LifecycleConfig: {name}", lo, MAX_FRAME)
         if self.relink_coast is not None:
             integer(self.relink_coast, "LifecycleConfig: relink_coast", 1, MAX_FRAME)
-        if self.miss_window is not None:
-            integer(self.miss_window, "LifecycleConfig: miss_window", 1, MAX_FRAME)
         if self.blind_coast is not None:
             integer(self.blind_coast, "LifecycleConfig: blind_coast", 0, MAX_FRAME)
         _in_unit_interval(

@@ -127,9 +127,6 @@ class LiveTrack:
     #: this frame's was (:attr:`flat`). Class defaults: a checkpoint pickled before them has none.
     blind = 0
     flat = False
-    #: Frames with detections missed since birth (see :meth:`alive`); a class default for a
-    #: checkpoint pickled before it was counted.
-    missed_all = 0
 
     def __init__(self, track_id: int, box_xywh: F64, reference: F64, config: TrackerConfig,
                  seed: int, score: float) -> None:  # fmt: skip
@@ -157,7 +154,6 @@ class LiveTrack:
         self.age = 1
         self.time_since_update = 0
         self.missed = 0  # frames with detections since the last match (see alive)
-        self.missed_all = 0  # frames with detections missed since birth (see alive)
         # the last matched detections' (frame, centre x, centre y, height): see speed
         self.trail: list[tuple[int, float, float, float]] = []
         self.score = score
@@ -235,7 +231,6 @@ class LiveTrack:
         """
         self.time_since_update += 1
         self.missed += int(detected)
-        self.missed_all += int(detected)
         if not self.flat:
             self.blind = 0
         elif detected:
@@ -243,7 +238,7 @@ class LiveTrack:
         self.det_index = None
         self.score = self.rho
 
-    def alive(self, rules: LifecycleConfig, misses: int = 0) -> bool:
+    def alive(self, rules: LifecycleConfig) -> bool:
         """Tell whether the track has coasted no longer than it may (less if unconfirmed).
 
         A confirmed track may coast `max_coast` frames. A tentative one may miss
@@ -253,15 +248,12 @@ class LiveTrack:
         detector's, ends after more than `blind_coast` frames with detections in a row coasted
         blind, its colour likelihood flat (:attr:`blind`): on frames of one colour, or, with the
         built-in detector's foreground-only bins, with no foreground pixel under any particle.
-        A tentative track that has missed no more than `misses` frames with detections since
-        its birth lives on too (``LifecycleConfig.miss_window``), as long as `max_coast` allows.
         """
         if rules.blind_coast is not None and self.blind > rules.blind_coast:
             return False
         if self.hits >= rules.min_hits:
             return self.time_since_update <= rules.max_coast
-        missed = self.missed <= rules.tentative_coast or self.missed_all <= misses
-        return missed and self.time_since_update <= rules.max_coast
+        return self.missed <= rules.tentative_coast and self.time_since_update <= rules.max_coast
 
     def speed(
         self, frame_index: int, centre: Sequence[float], height: float, span: int

@@ -232,9 +232,6 @@ class MultiObjectTracker:
         # cars never raise the people's noise; the most recent samples of each class
         self._speeds: dict[int, RollingMedian] = {}
         self._gains: dict[int, float] = {}
-        # (misses, confirmed tracks counted) of the last frames with detections: the confirmed
-        # tracks' miss rate (LifecycleConfig.miss_window, see tentative_misses)
-        self._misses: deque[tuple[int, int]] = deque()
 
     def _take(self, method: str) -> None:
         """Hold the tracker for one call, without waiting (RuntimeError naming `method`).
@@ -274,7 +271,6 @@ class MultiObjectTracker:
         # made when the window started at frame 1: it goes on doing so
         state.setdefault("_birth_start", 1)
         state.setdefault("copies_given", False)  # set by every update before it is read
-        state.setdefault("_misses", deque())  # made before the miss rate was measured
         self.__dict__.update(state)
         self._busy = threading.Lock()  # a checkpoint pickled before the lock had none
 
@@ -817,9 +813,8 @@ class MultiObjectTracker:
         classes_t = [t.cls for t in tracks]
         # one class everywhere (the usual case): every pair is allowed
         one_class = not any(classes_t) and not labels.any()
-        track_boxes = np.array([t.box for t in tracks]).reshape(-1, 4)
         result = associate(
-            track_boxes,
+            np.array([t.box for t in tracks]).reshape(-1, 4),
             np.array([t.size[1] for t in tracks]),
             np.array([t.time_since_update for t in tracks]),
             np.array([t.filter.reference for t in tracks]),
@@ -878,10 +873,7 @@ class MultiObjectTracker:
         self._measure_speeds(followed, boxes, cfg)
 
         # 4. tracks that coasted too long end; 5. unexplained detections start tracks
-        misses = 0
-        if cfg.lifecycle.miss_window is not None and detections is not None:
-            misses = self._count_misses(track_boxes, result.matches, detected, f.shape, cfg)
-        alive = [t.alive(cfg.lifecycle, misses) for t in self.tracks]
+        alive = [t.alive(cfg.lifecycle) for t in self.tracks]
         self._ended_unconfirmed.update(
             t.id
             for t, a in zip(self.tracks, alive, strict=True)
@@ -928,49 +920,6 @@ class MultiObjectTracker:
         early = self.frame_index <= cfg.lifecycle.min_hits
         reports = (t.report(self.frame_index, early, cfg.lifecycle) for t in self.tracks)
         return [r for r in reports if r is not None]
-
-    def _count_misses(self, track_boxes: F64, matches: Sequence[tuple[int, int]], detected: bool,
-                      shape: tuple[int, ...], cfg: TrackerConfig) -> int:  # fmt: skip
-        """Count this frame's misses; return the misses a tentative track may have had.
-
-        On a frame with detections, the confirmed tracks (at least ``min_hits`` matches before
-        this frame) whose predicted box (`track_boxes`, before association) lies inside the
-        frame and overlaps no other track's are counted, and those without a detection
-        (not in `matches`) are misses. Over the last ``miss_window`` such frames, the miss rate
-        ``p`` gives ``round((min_hits - 1) p / (1 - p))``: the misses a person whom the
-        detector misses at that rate collects, on average, while a tentative track waits for
-        its further matches (``LifecycleConfig.miss_window``). 0 before any such track.
-        """
-        rules = cfg.lifecycle
-        window = rules.miss_window
-        assert window is not None
-        if detected and len(track_boxes):
-            h, w = shape[:2]
-            x, y, bw, bh = track_boxes.T
-            inside = (x >= 0) & (y >= 0) & (x + bw <= w) & (y + bh <= h)
-            # overlapping another track: the two boxes intersect at all
-            x2, y2 = x + bw, y + bh
-            ix = np.minimum(x2[:, None], x2[None, :]) - np.maximum(x[:, None], x[None, :])
-            iy = np.minimum(y2[:, None], y2[None, :]) - np.maximum(y[:, None], y[None, :])
-            touch = (ix > 0) & (iy > 0)
-            np.fill_diagonal(touch, False)
-            hit = np.zeros(len(track_boxes), np.bool_)
-            hit[[ti for ti, _ in matches]] = True
-            # the matches before this frame's (which LiveTrack.matched counted already)
-            before = np.array([t.hits for t in self.tracks]) - hit
-            confirmed = before >= rules.min_hits
-            counted = confirmed & inside & ~touch.any(axis=1)
-            self._misses.append((int(np.count_nonzero(counted & ~hit)), int(counted.sum())))
-            while len(self._misses) > window:
-                self._misses.popleft()
-        missed = sum(m for m, _ in self._misses)
-        total = sum(n for _, n in self._misses)
-        if total == 0:
-            return 0
-        p = missed / total
-        if p >= 1.0:
-            return rules.max_coast
-        return math.floor((rules.min_hits - 1) * p / (1 - p) + 0.5)
 
     def _beside(self, boxes: F64, labels: NDArray[np.int64], unmatched: Sequence[int],
                 cfg: TrackerConfig) -> set[int]:  # fmt: skip
