@@ -24,10 +24,10 @@ from pftrack.io.marks import (
     is_marked_csv,
     is_marked_image,
     is_marked_json,
-    is_mot_text,
     json_marked,
     mark_image,
 )
+from pftrack.io.mot import is_mot_text, read_mot
 from pftrack.synthetic import make_scene
 from tests.test_cli import _walkers
 
@@ -134,6 +134,20 @@ def test_another_trackers_mot_file_is_replaced_as_motchallenge_tools_do(
     for text in ("frame,id,x,y,w,h\n", "1,2,3,4,5\n", "1,2,3,4,5,six\n", "\0binary"):
         out.write_text(text)
         assert not is_mot_text(out), text
+
+
+def test_mot_text_is_what_read_mot_reads_as_rows(tmp_path: Path) -> None:
+    """The test of a tracks ``--out`` and ``read_mot`` agree (it had its own split and number
+    pattern: a UTF-16 file ``read_mot`` reads was refused, full-width digits it refuses were
+    taken, as was a row with an empty column)."""
+    path = tmp_path / "rows.txt"
+    path.write_text("1,1,10,10,5,5,1,-1,-1,-1\n", encoding="utf-16")
+    assert is_mot_text(path) and read_mot(path).shape == (1, 10)
+    for text in ("\uff11,1,10,10,5,5\n", "1,,10,10,5,5,1\n"):
+        path.write_text(text, encoding="utf-8")
+        assert not is_mot_text(path), text
+        with pytest.raises(ValueError):
+            read_mot(path)
 
 
 @pytest.mark.parametrize("ext", [".png", ".jpg"])

@@ -24,6 +24,7 @@ from pftrack._text import counted
 from pftrack._typing import PathLike
 from pftrack._warn import warn
 from pftrack.io.atomic import refuse_dash, refuse_loop
+from pftrack.io.mot import is_mot_text
 from pftrack.io.video import (
     VIDEO_SUFFIXES,
     image_files,
@@ -273,8 +274,6 @@ def _refuse_tracks_file(path: Path) -> None:
     ``pftrack batch gt.txt`` (a tracks file meant for ``recover`` or ``smooth``) was a task
     that failed as "not a video", exit 1, after the batch had started and made ``--out``.
     """
-    from pftrack.io.marks import is_mot_text
-
     if (
         path.is_file()
         and path.suffix.lower() not in VIDEO_SUFFIXES

@@ -82,8 +82,7 @@ def run(args: argparse.Namespace) -> int:
     args.tracks = args.tracks[0]
     from pftrack.cli._signals import hold_interrupts
     from pftrack.io.atomic import check_output, check_replaceable
-    from pftrack.io.marks import is_mot_text
-    from pftrack.io.mot import write_mot
+    from pftrack.io.mot import is_mot_text, write_mot
     from pftrack.recovery import fill_gaps, link_tracklets
     from pftrack.recovery.fill import copied_values, unfilled_note
     from pftrack.recovery.linking import link_config_for, read_tracks

@@ -60,8 +60,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.cli._signals import hold_interrupts
     from pftrack.cli.recover import flag_note
     from pftrack.io.atomic import check_output, check_replaceable
-    from pftrack.io.marks import is_mot_text
-    from pftrack.io.mot import write_mot
+    from pftrack.io.mot import is_mot_text, write_mot
     from pftrack.recovery.fill import long_holes, unfilled_note
     from pftrack.recovery.linking import link_config_for, read_tracks
     from pftrack.tracking import smooth_tracks

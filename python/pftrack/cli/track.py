@@ -241,7 +241,8 @@ def _check_outputs(args: argparse.Namespace, live: bool) -> None:
     """Before any work: the detection file can be read, every output written, none twice."""
     from pftrack.cli._options import check_input_file
     from pftrack.io.atomic import check_distinct, check_output, check_replaceable
-    from pftrack.io.marks import is_marked_image, is_mot_text
+    from pftrack.io.marks import is_marked_image
+    from pftrack.io.mot import is_mot_text
     from pftrack.io.video import check_outside_frames, find_sequence, source_files
     from pftrack.io.video_writer import VIDEO_SUFFIXES, is_render
 

@@ -818,7 +818,7 @@ def check_output(
         first 8 KiB: a video, a picture) is then refused, so that ``--out annotated.mp4``
         typed for ``--render annotated.mp4`` does not replace the video with text (was:
         replaced without a word). Which text file is replaced is :func:`check_replaceable`'s
-        (:func:`pftrack.io.marks.is_mot_text`: MOTChallenge rows, or ``--force``).
+        (:func:`pftrack.io.mot.is_mot_text`: MOTChallenge rows, or ``--force``).
 
     Raises
     ------

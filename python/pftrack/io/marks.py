@@ -13,7 +13,8 @@ any work, unless the command's ``--force`` is given. Each kind carries a mark:
 - a tracks file (``--out`` of ``track``, ``recover``, ``smooth``): MOTChallenge text has no
   room for a mark that every MOTChallenge tool reads, and their users re-run a tracker into
   the file of its last run, so any file of MOTChallenge rows is replaceable (another tracker's
-  too): one whose first line holding a field has 6 or more numbers (:func:`is_mot_text`).
+  too): one whose first row :func:`pftrack.io.mot.read_mot` would read as such
+  (:func:`pftrack.io.mot.is_mot_text`).
 """
 
 from __future__ import annotations
@@ -31,7 +32,6 @@ __all__ = [
     "is_marked_csv",
     "is_marked_image",
     "is_marked_json",
-    "is_mot_text",
     "json_marked",
     "mark_image",
 ]
@@ -46,7 +46,6 @@ _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 _PNG_TEXT = b"Software\0" + IMAGE_MARK
 _JSON_START = re.compile(rb'\A\s*\{\s*"written_by"\s*:\s*"pftrack')
 _HEAD = 1 << 16  # bytes read of a file to find its mark
-_NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?|[-+]?(nan|inf)", re.IGNORECASE)
 
 
 def _head(path: PathLike) -> bytes:
@@ -130,31 +129,6 @@ def is_marked_csv(path: PathLike) -> bool:
         return _head(path).startswith(CSV_MARK.encode())
     except OSError:
         return False
-
-
-def is_mot_text(path: PathLike) -> bool:
-    """Whether `path` holds MOTChallenge rows: its first line holding a field has >= 6 numbers.
-
-    Blank lines and ``#`` comments are passed over (pftrack's reader does too); a file of only
-    those is one :func:`pftrack.io.mot.read_mot` reads as no rows: replaceable too.
-    """
-    try:
-        head = _head(path)
-    except OSError:
-        return False
-    if b"\0" in head:
-        return False
-    text = head.decode("utf-8-sig", errors="replace")  # a byte-order mark, as read_mot takes
-    lines = text.splitlines()
-    if len(head) == _HEAD and lines:
-        lines = lines[:-1]  # the last may be cut
-    for line in lines:
-        line = line.strip()
-        if not line or line.startswith("#"):
-            continue
-        fields = [f for f in re.split(r"[,\s]+", line) if f]
-        return len(fields) >= 6 and all(_NUMBER.fullmatch(f) for f in fields[:6])
-    return True
 
 
 def json_marked(doc: Mapping[str, object], command: str) -> dict[str, object]:

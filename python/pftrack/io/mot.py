@@ -134,6 +134,30 @@ def first_row_fields(path: PathLike) -> int:
     return 0 if first is None else len(_fields(first[1]))
 
 
+def is_mot_text(path: PathLike) -> bool:
+    """Whether `path` holds MOTChallenge rows: its first row has 6 or more fields, 6 numbers.
+
+    Read as :func:`read_mot` reads it (its encoding, a UTF-16 file with its byte-order mark
+    included; blank lines and ``#`` comments passed over; its fields and numbers), so a file
+    it is true of is one ``read_mot`` takes as rows, and a file of no row (empty, comments
+    only) counts too. A binary file (NUL bytes in its first 8 KiB, UTF-16 aside) is not; an
+    unreadable path neither. What a tracks ``--out`` may replace (docs/io.md).
+    """
+    p = Path(path)
+    try:
+        with p.open("rb") as fh:
+            head = fh.read(8192)
+        if b"\0" in head and _encoding(head) != "utf-16":
+            return False
+        first = next(_data_lines(p), None)
+    except OSError:
+        return False
+    if first is None:
+        return True
+    fields = _fields(first[1])
+    return len(fields) >= 6 and all(_NUMBER.fullmatch(f) for f in fields[:6])
+
+
 def data_line_numbers(path: PathLike) -> list[int]:
     """The file's line number of each row :func:`read_mot` returns, for error messages."""
     return [n for n, _ in _data_lines(Path(path))]
