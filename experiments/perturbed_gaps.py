@@ -78,10 +78,32 @@ def _shake(rows: F64, width: float, height: float, fps: float, rng: np.random.Ge
     return out
 
 
-def _half_fps(rows: F64, width: float, height: float, fps: float, rng: np.random.Generator) -> F64:
-    out = rows[rows[:, 0] % 2 == 1].copy()
-    out[:, 0] = (out[:, 0] + 1) // 2
+def _seen_at(rows: F64, ratio: float) -> F64:
+    """`rows` at 1/`ratio` of their frame rate: new frame k is old frame 1 + round((k - 1) ratio).
+
+    A whole `ratio` keeps every ratio-th frame from the first; 30/14 steps 2 or 3 frames.
+    """
+    last = int(rows[:, 0].max())
+    old = 1 + np.rint(np.arange(last) * ratio).astype(int)  # old frame of new frame k
+    old = old[old <= last]
+    new = np.full(last + 1, 0)
+    new[old] = np.arange(1, len(old) + 1)
+    out = rows[new[rows[:, 0].astype(int)] > 0].copy()
+    out[:, 0] = new[out[:, 0].astype(int)]
     return out
+
+
+def _scaled(rows: F64, s: F64, width: float, height: float) -> F64:
+    """Each box scaled about the image centre by its row's `s` (corner and size alike)."""
+    centre = np.array([width / 2.0, height / 2.0])
+    out = rows.copy()
+    out[:, 2:4] = centre + s[:, None] * (rows[:, 2:4] - centre)
+    out[:, 4:6] *= s[:, None]
+    return out
+
+
+def _half_fps(rows: F64, width: float, height: float, fps: float, rng: np.random.Generator) -> F64:
+    return _seen_at(rows, 2.0)
 
 
 def _jitter(rows: F64, width: float, height: float, fps: float, rng: np.random.Generator) -> F64:
@@ -91,39 +113,20 @@ def _jitter(rows: F64, width: float, height: float, fps: float, rng: np.random.G
 
 
 def _third_fps(rows: F64, width: float, height: float, fps: float, rng: np.random.Generator) -> F64:
-    out = rows[rows[:, 0] % 3 == 1].copy()
-    out[:, 0] = (out[:, 0] + 2) // 3
-    return out
+    return _seen_at(rows, 3.0)
 
 
 def _zoom(rows: F64, width: float, height: float, fps: float, rng: np.random.Generator) -> F64:
-    s = 1.0 + 0.15 * np.sin(2 * np.pi * rows[:, 0] / fps / 10.0)
-    centre = np.array([width / 2.0, height / 2.0])
-    out = rows.copy()
-    out[:, 2:4] = centre + s[:, None] * (rows[:, 2:4] - centre)
-    out[:, 4:6] *= s[:, None]
-    return out
+    return _scaled(rows, 1.0 + 0.15 * np.sin(2 * np.pi * rows[:, 0] / fps / 10.0), width, height)
 
 
 def _fps14(rows: F64, width: float, height: float, fps: float, rng: np.random.Generator) -> F64:
-    last = int(rows[:, 0].max())
-    old = 1 + np.rint(np.arange(last) * (30.0 / 14.0)).astype(int)  # old frame of new frame k
-    old = old[old <= last]
-    new = np.full(last + 1, 0)
-    new[old] = np.arange(1, len(old) + 1)
-    out = rows[new[rows[:, 0].astype(int)] > 0].copy()
-    out[:, 0] = new[out[:, 0].astype(int)]
-    return out
+    return _seen_at(rows, 30.0 / 14.0)
 
 
 def _walk(rows: F64, width: float, height: float, fps: float, rng: np.random.Generator) -> F64:
     f0, f1 = rows[:, 0].min(), rows[:, 0].max()
-    s = 1.0 + 0.5 * (rows[:, 0] - f0) / max(f1 - f0, 1.0)
-    centre = np.array([width / 2.0, height / 2.0])
-    out = rows.copy()
-    out[:, 2:4] = centre + s[:, None] * (rows[:, 2:4] - centre)
-    out[:, 4:6] *= s[:, None]
-    return out
+    return _scaled(rows, 1.0 + 0.5 * (rows[:, 0] - f0) / max(f1 - f0, 1.0), width, height)
 
 
 PERTURBATIONS: dict[str, Perturb] = {
