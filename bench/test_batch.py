@@ -9,9 +9,9 @@ nice pytest bench/test_batch.py --benchmark-enable --benchmark-only --benchmark-
   at one thread as ``pftrack track`` and ``pftrack batch --workers 0`` set it) and on a warm
   two-worker ``LocalCluster``; on that cluster again with each worker's read-ahead, detector
   and kernel threads switched on (``PFTRACK_TRACKING_THREADS=1``: the plugin switches them off;
-  whether two workers of three threads on two cores cost less CPU than of one is stop 68's and
-  69's open lead); and once more including the cluster's start and close, as ``pftrack batch``
-  does it. Goal: serial / two workers >= 1.7 on two cores. Untimed
+  quiet, stop 69 found them costing each worker CPU and the run wall: docs/batch.md); and
+  once more including the cluster's start and close, as ``pftrack batch`` does it. Goal:
+  serial / two workers >= 1.7 on two cores. Untimed
   (``--benchmark-disable``, as CI runs the benchmarks as tests) the four cases take the smallest
   input that still runs the same path, four links to a synthetic 160x120 video of 8 frames (they
   took 27 % of CI's bench step on PETS09's 795 frames); ``extra_info["video"]`` says so.
@@ -263,7 +263,7 @@ def test_four_two_workers_pipeline_threads(
     benchmark: BenchmarkFixture, four_sequences: Path, client: Any, tmp_path: Path
 ) -> None:
     """The warm case with each worker's read-ahead, detector and kernel threads switched on (a
-    worker's plugin switches them off): the lead of stops 68 and 69, on and off in one run."""
+    worker's plugin switches them off): on and off in one run (off won quietly at stop 69)."""
     _run([four_sequences / "seq1.avi"], tmp_path, client)  # workers import pftrack: not timed
     client.run(_set_worker_threads, "1")
     try:
