@@ -185,28 +185,41 @@ inline __attribute__((always_inline)) std::uint8_t mask_byte(bool is_cand, float
                                      (255 - 128 * static_cast<std::int32_t>(shadow)));
 }
 
-/// Pixels a chunk of `background_row_candidates` holds: the shadow test runs only in the
-/// chunks with a candidate (most chunks have none: 65-89 % of them on the bench's scene,
-/// PETS09 and TUD-Campus).
-constexpr Index kCandidateChunk = 32;
+/// Pixels a chunk of `row_candidates` holds: the shadow test runs only in the chunks with a
+/// candidate (most chunks have none: 65-89 % of the 32-pixel chunks on the bench's scene,
+/// PETS09 and TUD-Campus). 16 since stop 70: 0.054 M fewer instructions a PETS09 frame than 32
+/// with the update in the differences' loop (8 took 0.46 M more: callgrind, det70's harness).
+constexpr Index kCandidateChunk = 16;
 
 /// Per pixel of one row, in float (exact on these small integers): floor(d_bg) clamped to 255,
 /// the candidate flag (1 or 0) and the mask byte (`difference`, `mask_byte`). Chunk by chunk of
 /// `kCandidateChunk` pixels, each loop branch-free (vectorised): the differences, then the
 /// shadow test only where the chunk has a candidate (the mask is 0 wherever there is none, so
-/// the bytes are those of the test run on every pixel).
-PFTRACK_VECTOR_CLONES static void background_row_candidates(
+/// the bytes are those of the test run on every pixel). With `kUpdate`, the differences' loop
+/// also writes the selective update (`background_row_update`'s arithmetic) into `ub, ug, ur`,
+/// the next frame's background: another buffer than `qb, qg, qr`, which the shadow test of the
+/// chunk reads after it (one pass over the row's floats instead of two).
+template <bool kUpdate>
+inline __attribute__((always_inline)) void row_candidates(
     Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
     const float* __restrict qb, const float* __restrict qg, const float* __restrict qr,
     const float* __restrict dprev, float t, float t_low, ShadowBounds sh,
-    std::int32_t* __restrict di, float* __restrict cand, std::uint8_t* __restrict m) {
+    std::int32_t* __restrict di, float* __restrict cand, std::uint8_t* __restrict m, float a_bg,
+    float a_fg, float* __restrict ub, float* __restrict ug, float* __restrict ur) {
     Index x0 = 0;
     for (; x0 + kCandidateChunk <= n; x0 += kCandidateChunk) {
         std::int32_t any = 0;
-        for (Index x = x0; x < x0 + kCandidateChunk; ++x)
-            any |= static_cast<std::int32_t>(
-                difference(fb[x], fg[x], fr[x], qb[x], qg[x], qr[x], dprev[x], t, t_low, di[x],
-                           cand[x]));
+        for (Index x = x0; x < x0 + kCandidateChunk; ++x) {
+            const bool is_cand = difference(fb[x], fg[x], fr[x], qb[x], qg[x], qr[x], dprev[x],
+                                            t, t_low, di[x], cand[x]);
+            any |= static_cast<std::int32_t>(is_cand);
+            if constexpr (kUpdate) {
+                const float a = is_cand ? a_fg : a_bg;
+                ub[x] = qb[x] + a * (fb[x] - qb[x]);
+                ug[x] = qg[x] + a * (fg[x] - qg[x]);
+                ur[x] = qr[x] + a * (fr[x] - qr[x]);
+            }
+        }
         if (any == 0) {
             std::memset(m + x0, 0, static_cast<size_t>(kCandidateChunk));
             continue;
@@ -219,18 +232,43 @@ PFTRACK_VECTOR_CLONES static void background_row_candidates(
             difference(fb[x], fg[x], fr[x], qb[x], qg[x], qr[x], dprev[x], t, t_low, di[x],
                        cand[x]);
         m[x] = mask_byte(is_cand, fb[x], fg[x], fr[x], qb[x], qg[x], qr[x], sh);
+        if constexpr (kUpdate) {
+            const float a = is_cand ? a_fg : a_bg;
+            ub[x] = qb[x] + a * (fb[x] - qb[x]);
+            ug[x] = qg[x] + a * (fg[x] - qg[x]);
+            ur[x] = qr[x] + a * (fr[x] - qr[x]);
+        }
     }
 }
 
-/// `background_row_candidates` with the HsvLut indices (sat, hue) of every pixel.
-PFTRACK_VECTOR_CLONES static void background_row_scan(
+/// `row_candidates` without the update (a caller's hold mask: `background_row_update_held`).
+PFTRACK_VECTOR_CLONES static void background_row_candidates(
     Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
     const float* __restrict qb, const float* __restrict qg, const float* __restrict qr,
     const float* __restrict dprev, float t, float t_low, ShadowBounds sh,
-    std::int32_t* __restrict si, std::int32_t* __restrict hi, std::int32_t* __restrict di,
-    float* __restrict cand, std::uint8_t* __restrict m) {
+    std::int32_t* __restrict di, float* __restrict cand, std::uint8_t* __restrict m) {
+    row_candidates<false>(n, fb, fg, fr, qb, qg, qr, dprev, t, t_low, sh, di, cand, m, 0.0f,
+                          0.0f, nullptr, nullptr, nullptr);
+}
+
+/// `row_candidates` with the update into `ub, ug, ur` (a = a_fg where cand, else a_bg).
+PFTRACK_VECTOR_CLONES static void background_row_candidates_update(
+    Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
+    const float* __restrict qb, const float* __restrict qg, const float* __restrict qr,
+    const float* __restrict dprev, float t, float t_low, ShadowBounds sh,
+    std::int32_t* __restrict di, float* __restrict cand, std::uint8_t* __restrict m, float a_bg,
+    float a_fg, float* __restrict ub, float* __restrict ug, float* __restrict ur) {
+    row_candidates<true>(n, fb, fg, fr, qb, qg, qr, dprev, t, t_low, sh, di, cand, m, a_bg, a_fg,
+                         ub, ug, ur);
+}
+
+/// The HsvLut indices (sat, hue) of one row's float planes (see `hsv_indices`).
+PFTRACK_VECTOR_CLONES static void hsv_plane_indices(Index n, const float* __restrict fb,
+                                                    const float* __restrict fg,
+                                                    const float* __restrict fr,
+                                                    std::int32_t* __restrict si,
+                                                    std::int32_t* __restrict hi) {
     for (Index x = 0; x < n; ++x) hsv_indices(fb[x], fg[x], fr[x], si[x], hi[x]);
-    background_row_candidates(n, fb, fg, fr, qb, qg, qr, dprev, t, t_low, sh, di, cand, m);
 }
 
 /// One row of BGR bytes -> float planes b, g, r and d_prev = max_c |I_c - I'_c| against the
@@ -253,30 +291,20 @@ PFTRACK_VECTOR_CLONES static void background_row_split(
     }
 }
 
-/// `background_row_update` with a hold row: a = 0 where cand and hold != 0 (a tracked
-/// object's pixels, kept out of the background), else a_fg where cand, else a_bg.
+/// The selective update with a hold row, from this frame's background `qb, qg, qr` into the
+/// next one's `ub, ug, ur`: background_c + a (frame_c - background_c), a = 0 where cand and
+/// hold != 0 (a tracked object's pixels, kept out of the background), else a_fg where cand,
+/// else a_bg.
 PFTRACK_VECTOR_CLONES static void background_row_update_held(
     Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
-    float* __restrict qb, float* __restrict qg, float* __restrict qr, const float* __restrict cand,
-    const std::uint8_t* __restrict hold, float a_bg, float a_fg) {
+    const float* __restrict qb, const float* __restrict qg, const float* __restrict qr,
+    const float* __restrict cand, const std::uint8_t* __restrict hold, float a_bg, float a_fg,
+    float* __restrict ub, float* __restrict ug, float* __restrict ur) {
     for (Index x = 0; x < n; ++x) {
         const float a = cand[x] != 0.0f ? (hold[x] != 0 ? 0.0f : a_fg) : a_bg;
-        qb[x] = qb[x] + a * (fb[x] - qb[x]);
-        qg[x] = qg[x] + a * (fg[x] - qg[x]);
-        qr[x] = qr[x] + a * (fr[x] - qr[x]);
-    }
-}
-
-/// background_c += a (frame_c - background_c), a = a_fg where cand, else a_bg.
-PFTRACK_VECTOR_CLONES static void background_row_update(
-    Index n, const float* __restrict fb, const float* __restrict fg, const float* __restrict fr,
-    float* __restrict qb, float* __restrict qg, float* __restrict qr, const float* __restrict cand,
-    float a_bg, float a_fg) {
-    for (Index x = 0; x < n; ++x) {
-        const float a = cand[x] != 0.0f ? a_fg : a_bg;
-        qb[x] = qb[x] + a * (fb[x] - qb[x]);
-        qg[x] = qg[x] + a * (fg[x] - qg[x]);
-        qr[x] = qr[x] + a * (fr[x] - qr[x]);
+        ub[x] = qb[x] + a * (fb[x] - qb[x]);
+        ug[x] = qg[x] + a * (fg[x] - qg[x]);
+        ur[x] = qr[x] + a * (fr[x] - qr[x]);
     }
 }
 
@@ -332,6 +360,7 @@ public:
         rows_ = cols_ = 0;
         frame_count_ = 0;
         background_.clear();
+        next_.clear();
         previous_.clear();
         threshold_scale_ = 1.0;
         threshold_ = config_.t_min;
@@ -483,28 +512,37 @@ public:
         std::int32_t* __restrict hi = si + ns;
         std::int32_t* __restrict di = hi + ns;
         const detail::ShadowBounds sh{s_lo, s_chroma};
-        // Each row in four loops over L1-resident row buffers: (1), (3), (5) are vectorised by
-        // the compiler (the shadow test of (3) too, over every pixel of each 32-pixel chunk that
-        // has a candidate, skipped in the others: cheaper than branching pixel by pixel);
-        // (4) does the table look-ups and the histogram, which cannot be vectorised.
+        // The next frame's background goes into a second buffer (swapped in at the end), so
+        // that the differences' loop can write the update while the shadow test after it still
+        // reads this frame's background.
+        next_.resize(background_.size());
+        // Each row in three or four loops over L1-resident row buffers: (1), (2), (3) are
+        // vectorised by the compiler (the shadow test of (2) too, over every pixel of each
+        // 16-pixel chunk that has a candidate, skipped in the others: cheaper than branching
+        // pixel by pixel); (4) does the table look-ups and the histogram, which cannot be.
         for (Index y = 0; y < rows; ++y) {
             const std::uint8_t* __restrict px = bgr + y * row_stride;
-            float* __restrict qb = background_.data() + y * n3;
-            float* __restrict qg = qb + cols;
-            float* __restrict qr = qg + cols;
+            const float* __restrict qb = background_.data() + y * n3;
+            const float* __restrict qg = qb + cols;
+            const float* __restrict qr = qg + cols;
+            float* __restrict ub = next_.data() + y * n3;
             std::uint8_t* __restrict prev = previous_.data() + y * n3;  // planar, as qb
             std::int16_t* __restrict o = bins != nullptr ? bins + y * cols : nullptr;
             std::uint8_t* __restrict m = mask + y * cols;
             // (1) deinterleave into float planes, d_prev; I' <- I
             detail::background_row_split(cols, px, prev, prev + cols, prev + 2 * cols, fb, fg, fr,
                                          dprev);
-            // (3) per pixel, vectorised: table indices (with bins), d_bg, candidates, mask
-            if (o != nullptr)
-                detail::background_row_scan(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low, sh, si,
-                                            hi, di, cand, m);
+            // (2) per pixel: d_bg, candidates, mask, and (without a hold row) the selective
+            //     update background_c + a (frame_c - background_c) into the next buffer
+            if (hold == nullptr)
+                detail::background_row_candidates_update(cols, fb, fg, fr, qb, qg, qr, dprev, t,
+                                                         t_low, sh, di, cand, m, a_bg, a_fg, ub,
+                                                         ub + cols, ub + 2 * cols);
             else
                 detail::background_row_candidates(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low,
                                                   sh, di, cand, m);
+            // (3) table indices (with bins)
+            if (o != nullptr) detail::hsv_plane_indices(cols, fb, fg, fr, si, hi);
             // (4) bins by table look-up, histogram of floor(d_bg)
             if (o != nullptr)
                 for (Index x = 0; x < cols; ++x)
@@ -515,13 +553,13 @@ public:
             for (; x + 8 <= cols; x += 8)
                 for (size_t q = 0; q < 8; ++q) ++h8[q][static_cast<size_t>(di[x + static_cast<Index>(q)])];
             for (; x < cols; ++x) ++h8[static_cast<size_t>(x & 7)][static_cast<size_t>(di[x])];
-            // (5) background_c += a (frame_c - background_c), vectorised (selective update)
+            // (5) with a hold row, the selective update (a = 0 under the hold) into the next buffer
             if (hold != nullptr)
                 detail::background_row_update_held(cols, fb, fg, fr, qb, qg, qr, cand,
-                                                   hold + y * hold_stride, a_bg, a_fg);
-            else
-                detail::background_row_update(cols, fb, fg, fr, qb, qg, qr, cand, a_bg, a_fg);
+                                                   hold + y * hold_stride, a_bg, a_fg, ub,
+                                                   ub + cols, ub + 2 * cols);
         }
+        background_.swap(next_);
         for (size_t i = 0; i < 256; ++i) {
             std::int64_t c = 0;
             for (const auto& h : h8) c += h[i];
@@ -654,6 +692,7 @@ private:
     double threshold_ = 0.0;
     double threshold_scale_ = 1.0;  // set_threshold_scale
     std::vector<float> background_;      // planar rows: [y][channel][x]
+    std::vector<float> next_;  // apply's scratch: the next frame's background, swapped in
     std::vector<std::uint8_t> previous_;  // planar rows, as the background: [y][channel][x]
     std::array<std::int64_t, 256> hist_{};
     std::vector<double> ratios_;  // global_gain's sampled frame / background ratios
