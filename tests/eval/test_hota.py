@@ -429,7 +429,10 @@ def test_empty_ground_truth_and_results_equal_trackeval(
     ref = trackeval_hota(tmp_path, cases, "MOT15", ("HOTA", "CLEAR", "Identity"))
     parts = []
     for name, (gt, res) in cases.items():
-        s = evaluate_sequence(gt, res, benchmark="MOT15")
+        # results on the truth's frames that overlap none of its boxes: scored, and said
+        said = pytest.warns(UserWarning, match="none of the result's") if name == "apart" else None
+        with said or contextlib.nullcontext():
+            s = evaluate_sequence(gt, res, benchmark="MOT15")
         assert_same_clear(s.mot, ref[name])
         assert_same(s.hota, ref[name])
         for field in ("MOTA", "MOTP", "IDF1", "IDP", "IDR", "CLR_Pr", "CLR_Re"):
