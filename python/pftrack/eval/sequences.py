@@ -18,7 +18,6 @@ import json
 import math
 import os
 import re
-import warnings
 from collections.abc import Callable, Collection, Mapping, Sequence
 from pathlib import Path
 from typing import cast
@@ -29,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import NORMALISED_REACH, option
 from pftrack._progress import Report, check_report, part
 from pftrack._typing import BenchmarkName, PathLike
+from pftrack._warn import warn
 from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark
 from pftrack.eval.metrics import MotMetrics, check_image_size, combine_mot, evaluate_mot
 from pftrack.eval.rows import BENCHMARKS, _mot_iou, check_eval_rows, not_parts_message
@@ -596,7 +596,7 @@ def evaluate_sequence(
     if len(result) and m.num_objects and not m.num_matches:
         # as pftrack eval says it (was: MOTA -1.0 without a word for results numbered from
         # frame 101 against a truth of frames 1-71); an empty result is a finding, not a mix-up
-        warnings.warn(
+        warn(
             "evaluate_sequence: "
             f"{none_matched(result, gt, iou_threshold, whose=RESULTS)} (scored as given: "
             f"MOTA {m.mota:.3f})",
