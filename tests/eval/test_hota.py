@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -429,7 +430,14 @@ def test_empty_ground_truth_and_results_equal_trackeval(
     ref = trackeval_hota(tmp_path, cases, "MOT15", ("HOTA", "CLEAR", "Identity"))
     parts = []
     for name, (gt, res) in cases.items():
-        s = evaluate_sequence(gt, res, benchmark="MOT15")
+        # results on the truth's frames that overlap none of its boxes: scored, and said
+        said = (
+            pytest.warns(UserWarning, match="none of the result's")
+            if name == "apart"
+            else contextlib.nullcontext()
+        )
+        with said:
+            s = evaluate_sequence(gt, res, benchmark="MOT15")
         assert_same_clear(s.mot, ref[name])
         assert_same(s.hota, ref[name])
         for field in ("MOTA", "MOTP", "IDF1", "IDP", "IDR", "CLR_Pr", "CLR_Re"):
@@ -457,7 +465,7 @@ def test_every_figure_equals_trackeval_on_random_edge_cases(tmp_path: Path, seed
     here (1,000 more, seeds 100-199, agreed when it was written, 5 December).
     """
     from pftrack.eval import evaluate_sequence
-    from pftrack.eval.sequences import SequenceScores
+    from pftrack.eval.sequences import NONE_MATCHED, SequenceScores
     from tests.eval.cases import edge_case
 
     seen = np.zeros(3, dtype=int)  # the cases do exercise switches, ignored rows, ties
@@ -472,7 +480,15 @@ def test_every_figure_equals_trackeval_on_random_edge_cases(tmp_path: Path, seed
         for name in cases:
             g = read_mot(tmp_path / f"{k}" / "gt" / name / "gt" / "gt.txt")
             r = read_mot(tmp_path / f"{k}" / "trackers" / "t" / "data" / f"{name}.txt")
-            parts.append(evaluate_sequence(g, r, benchmark=bench, iou_threshold=thr))
+            with warnings.catch_warnings(record=True) as said:
+                warnings.simplefilter("always")
+                parts.append(evaluate_sequence(g, r, benchmark=bench, iou_threshold=thr))
+            # said exactly when some result box exists and none matched (TrackEval's counts)
+            m = parts[-1].mot
+            silent = not len(r) or not m.num_objects or m.num_matches > 0
+            assert [str(w.message).startswith(NONE_MATCHED) for w in said] == (
+                [] if silent else [True]
+            ), name
             frames = np.c_[g[:, 0], g[:, 2:6]]
             seen += [
                 parts[-1].mot.num_switches > 0,

@@ -28,6 +28,8 @@ def test_paths_are_size_checks_and_the_moving_path_four_times_slower() -> None:
     assert np.median([np.abs(fast[k] - fast[k - 1]).max() for k in range(1, 795)]) > 1.0
 
 
+# a tiny sequence the tracker matches nothing of: evaluate_sequence says so (stop 70)
+@pytest.mark.filterwarnings("ignore:evaluate_sequence. none of the result's:UserWarning")
 def test_run_counts_the_trackers_camera_only(data: Path) -> None:
     """Built-in detector: priming's probe is a CameraMotion of its own, not counted."""
     row = next(sl.video_rows(data, (Source("tiny", "img", 1.0),), ("slowpan",), sl.affines_of))
@@ -38,6 +40,8 @@ def test_run_counts_the_trackers_camera_only(data: Path) -> None:
     assert sl.run(row, frames, False, "on", 0)[1] == 12
 
 
+# a tiny sequence the tracker matches nothing of: evaluate_sequence says so (stop 70)
+@pytest.mark.filterwarnings("ignore:evaluate_sequence. none of the result's:UserWarning")
 def test_main_writes_the_table(data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     rows = sl.video_rows
     monkeypatch.setattr(

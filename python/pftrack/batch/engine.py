@@ -2055,7 +2055,30 @@ def _check_outputs(
                     f"{out_name} {out_dir / name} exists and no earlier batch wrote it ({why}); "
                     f"this run would replace it: move it, write elsewhere, or give {force_name}"
                 )
+            if any(name.endswith(s) for s in suffixes) and not _a_render(out_dir / name):
+                # named by a sidecar, but a video pftrack did not write put there since (was:
+                # replaced without a word, where --render and pftrack render refuse it)
+                raise ValueError(
+                    f"{render_name}'s output {out_dir / name} is a video pftrack did not write "
+                    "(a video of yours, put where an earlier batch's was?); this run would "
+                    f"replace it: move it, write elsewhere, or give {force_name}"
+                )
     return out_dir
+
+
+def _a_render(path: Path) -> bool:
+    """Whether the video `path` may be replaced as a render: empty, or marked as pftrack's.
+
+    The rule of ``--render`` and ``pftrack render --out``
+    (:func:`pftrack.io.video_writer.is_render`).
+    """
+    from pftrack.io.video_writer import is_render
+
+    try:
+        empty = path.stat().st_size == 0
+    except OSError:
+        return True  # gone meanwhile: nothing to replace
+    return empty or not path.is_file() or is_render(path)
 
 
 def _file_id(path: Path) -> tuple[int, int] | None:

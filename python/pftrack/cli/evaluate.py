@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import re
 import sys
+import warnings
 from collections.abc import Callable, Collection
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -251,19 +253,12 @@ def _none_matched(path: Path, res: F64, gt_path: Path, gt: F64, iou: float) -> l
     (was: a table of zeros without a word; a CLI trial scored TUD-Campus's tracks against
     PETS09's ground truth, MOTA -6.9). A scale apart is refused before, by the scale check.
     """
+    from pftrack.eval.sequences import none_matched
+
     if not len(res):  # an empty result says so itself
         return []
-
-    def span(a: F64) -> str:
-        first, last = int(a[:, 0].min()), int(a[:, 0].max())
-        return f"frame {first}" if first == last else f"frames {first}-{last}"
-
-    n = len(res)
-    return [
-        f"{path}: none of its {n} box{'es' * (n != 1)} ({span(res)}) matches a ground-truth "
-        f"box of {gt_path} ({span(gt)}) with IoU {iou:g} or more, on any frame: the tracks of "
-        "another sequence or video, or frames numbered otherwise?"
-    ]
+    # evaluate_sequence's own warning, with the files named (and "no frame in common" said)
+    return [f"{path}: {none_matched(res, gt, iou, whose='its', gt_name=str(gt_path))}"]
 
 
 def _bar_label(done: int, n: int) -> str:
@@ -291,6 +286,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.cli._signals import hold_interrupts
     from pftrack.eval.rows import gt_conf_note, result_class_note
     from pftrack.eval.sequences import (
+        NONE_MATCHED,
         SequenceScores,
         benchmark_of_path,
         check_scale,
@@ -356,16 +352,19 @@ def run(args: argparse.Namespace) -> int:
             # it; else guessed from the columns (was: always guessed, MOT20-train as MOT17)
             folder = benchmark_of_path(seq.gt_path) if args.benchmark == "auto" else None
             try:
-                scores[name] = evaluate_sequence(
-                    gt,
-                    res,
-                    iou_threshold=args.iou,
-                    scale=s,
-                    image_size=size,
-                    benchmark=folder[0] if folder else args.benchmark,
-                    num_frames=seq.length,
-                    on_progress=_mover(bar, sum(frames[:k]), frames[k]),
-                )
+                with warnings.catch_warnings():
+                    # said below as _none_matched's note, naming the files, after the outputs
+                    warnings.filterwarnings("ignore", message=re.escape(NONE_MATCHED))
+                    scores[name] = evaluate_sequence(
+                        gt,
+                        res,
+                        iou_threshold=args.iou,
+                        scale=s,
+                        image_size=size,
+                        benchmark=folder[0] if folder else args.benchmark,
+                        num_frames=seq.length,
+                        on_progress=_mover(bar, sum(frames[:k]), frames[k]),
+                    )
             except ValueError as exc:
                 message = _in_file(str(exc), seq.gt_path, path)
                 if folder and "MOT15-style" in message:  # say where MOT17 rules came from
