@@ -119,45 +119,34 @@ public:
         std::fill(t, t + row_len_, std::uint16_t(0));
         if (nx == 0) return;
         // band_of[x]: where pixel column x0 + x counts, band j (columns xs[j-1] .. xs[j]) at j s
+        // (Index: the sum with a bin's compact index needs no widening a pixel)
         band_of_.resize(static_cast<size_t>(xs_.back() - xs_.front()));
         for (Index j = 1; j < nx; ++j)
             for (Index x = xs_[static_cast<size_t>(j - 1)]; x < xs_[static_cast<size_t>(j)]; ++x)
-                band_of_[static_cast<size_t>(x - xs_.front())] = static_cast<std::int32_t>(j * s);
+                band_of_[static_cast<size_t>(x - xs_.front())] = j * s;
         const std::int16_t* local_of = local_of_.data() + 1;
-        const std::int32_t* band_of = band_of_.data();
+        const Index* band_of = band_of_.data();
         const Index cx0 = region_.x0 + xs_.front(), cw = xs_.back() - xs_.front();
         std::uint16_t* band = bands_.data();
-        std::uint16_t* run = local_.data();
+        std::fill(band, band + row_len_, std::uint16_t(0));  // sum_bands zeroes what it read
         for (Index i = 1; i < ny; ++i) {
-            std::fill(band, band + row_len_, std::uint16_t(0));
             for (Index y = ys_[static_cast<size_t>(i - 1)]; y < ys_[static_cast<size_t>(i)]; ++y) {
                 const std::int16_t* b = img.row(region_.y0 + y) + cx0;
-                for (Index x = 0; x < cw; ++x) ++band[band_of[x] + local_of[b[x]]];  // mod 2^16
+                Index x = 0;
+                for (; x + 4 <= cw; x += 4) {  // four a turn: the loop's own count and jump
+                    const Index l0 = band_of[x] + local_of[b[x]];
+                    const Index l1 = band_of[x + 1] + local_of[b[x + 1]];
+                    const Index l2 = band_of[x + 2] + local_of[b[x + 2]];
+                    const Index l3 = band_of[x + 3] + local_of[b[x + 3]];
+                    ++band[l0];  // mod 2^16, as every entry
+                    ++band[l1];
+                    ++band[l2];
+                    ++band[l3];
+                }
+                for (; x < cw; ++x) ++band[band_of[x] + local_of[b[x]]];
             }
             // T[i][j] = T[i-1][j] + the bands 1 .. j of the rows between the two corner rows
-            const std::uint16_t* above = t + (i - 1) * row_len_;
-            std::uint16_t* cur = t + i * row_len_;
-            std::fill(cur, cur + s, std::uint16_t(0));
-            std::fill(run, run + s, std::uint16_t(0));
-            for (Index j = 1; j < nx; ++j) {
-                const Index o = j * s;
-#if defined(__SSE2__)
-                for (int k = 0; k < s; k += kLanes) {
-                    auto* r = reinterpret_cast<__m128i*>(run + k);
-                    const __m128i v = _mm_add_epi16(
-                        _mm_loadu_si128(r), _mm_loadu_si128(reinterpret_cast<const __m128i*>(band + o + k)));
-                    _mm_storeu_si128(r, v);
-                    _mm_storeu_si128(reinterpret_cast<__m128i*>(cur + o + k),
-                                     _mm_add_epi16(v, _mm_loadu_si128(reinterpret_cast<const __m128i*>(
-                                                          above + o + k))));
-                }
-#else
-                for (int k = 0; k < s; ++k) {
-                    run[k] = static_cast<std::uint16_t>(run[k] + band[o + k]);
-                    cur[o + k] = static_cast<std::uint16_t>(above[o + k] + run[k]);
-                }
-#endif
-            }
+            sum_bands(t + (i - 1) * row_len_, t + i * row_len_, nx);
         }
     }
 
@@ -210,6 +199,66 @@ private:
         table_.reset(new std::uint16_t[table_capacity_]);  // default-initialised: not zeroed
     }
 
+    /// One corner row of the table: cur[j] = above[j] + (bands_ 1 .. j summed), cur[0] = 0;
+    /// bands_ is left zero for the next corner row (in the same pass: a memset call a corner
+    /// row cost more than the stores).
+    void sum_bands(const std::uint16_t* above, std::uint16_t* cur, Index nx) {
+        const int s = stride_;
+#if defined(__SSE2__)
+        switch (s / kLanes) {  // the running sum in registers: up to 16 vectors
+            case 1: return sum_bands_in<1>(above, cur, nx);
+            case 2: return sum_bands_in<2>(above, cur, nx);
+            case 3: return sum_bands_in<3>(above, cur, nx);
+            case 4: return sum_bands_in<4>(above, cur, nx);
+            case 5: return sum_bands_in<5>(above, cur, nx);
+            case 6: return sum_bands_in<6>(above, cur, nx);
+            case 7: return sum_bands_in<7>(above, cur, nx);
+            case 8: return sum_bands_in<8>(above, cur, nx);
+            case 9: return sum_bands_in<9>(above, cur, nx);
+            case 10: return sum_bands_in<10>(above, cur, nx);
+            case 11: return sum_bands_in<11>(above, cur, nx);
+            case 12: return sum_bands_in<12>(above, cur, nx);
+            case 13: return sum_bands_in<13>(above, cur, nx);
+            case 14: return sum_bands_in<14>(above, cur, nx);
+            case 15: return sum_bands_in<15>(above, cur, nx);
+            case 16: return sum_bands_in<16>(above, cur, nx);
+            default: break;
+        }
+#endif
+        std::fill(cur, cur + s, std::uint16_t(0));
+        std::uint16_t* run = local_.data();
+        std::fill(run, run + s, std::uint16_t(0));
+        std::uint16_t* band = bands_.data();
+        for (Index o = s; o < nx * s; o += s)
+            for (int k = 0; k < s; ++k) {
+                run[k] = static_cast<std::uint16_t>(run[k] + band[o + k]);
+                band[o + k] = 0;
+                cur[o + k] = static_cast<std::uint16_t>(above[o + k] + run[k]);
+            }
+    }
+
+#if defined(__SSE2__)
+    template <int V>
+    void sum_bands_in(const std::uint16_t* above, std::uint16_t* cur, Index nx) {
+        const __m128i zero = _mm_setzero_si128();
+        __m128i run[V];
+        for (int j = 0; j < V; ++j) {
+            run[j] = zero;
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(cur + j * kLanes), zero);
+        }
+        std::uint16_t* band = bands_.data();
+        for (Index o = V * kLanes; o < nx * V * kLanes; o += V * kLanes)
+            for (int j = 0; j < V; ++j) {
+                const Index k = o + j * kLanes;
+                auto* bk = reinterpret_cast<__m128i*>(band + k);
+                run[j] = _mm_add_epi16(run[j], _mm_loadu_si128(bk));
+                _mm_storeu_si128(bk, zero);
+                _mm_storeu_si128(reinterpret_cast<__m128i*>(cur + k),
+                                 _mm_add_epi16(run[j], _mm_loadu_si128(reinterpret_cast<const __m128i*>(above + k))));
+            }
+    }
+#endif
+
     /// xs_, ys_: the sorted distinct columns and rows (region-relative) the boxes start or end
     /// at; col_of_, row_of_: a corner's table column and row (other entries are not read).
     void corners(const std::vector<PixelRange>& ranges, const Index* m0, const Index* m1, Index w,
@@ -251,7 +300,7 @@ private:
     std::unique_ptr<std::uint16_t[]> table_;  // corner rows x corner columns x stride_ (of a larger buffer)
     std::vector<Index> xs_, ys_;             // the corner columns and rows (region-relative)
     std::vector<Index> col_of_, row_of_;     // region column / row -> table column / row
-    std::vector<std::int32_t> band_of_;      // column (from xs_[0]) -> its band's first entry
+    std::vector<Index> band_of_;             // column (from xs_[0]) -> its band's first entry
     std::vector<std::uint16_t> bands_;       // one corner row band's counts, by column band
     size_t table_capacity_ = 0;
     std::vector<std::uint16_t> local_;       // one box's (or one row's running) compact counts
