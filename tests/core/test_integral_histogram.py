@@ -82,6 +82,22 @@ def test_each_path_is_taken_and_agrees(rng):
         _weights_all_paths(image, boxes, r)
 
 
+def test_boxes_on_few_corners_one_pixel_bands_and_repeats(rng):
+    """The table is built at the boxes' corner rows and columns only (stop 70): boxes sharing
+    their edges (few corners, bands of many pixels between them), corners one pixel apart
+    (one-pixel bands), repeated boxes and one-pixel boxes all count as the reference does."""
+    image = _image(rng, 100, 140, 0.3)
+    r = _reference_histogram(image, rng)
+    xs = rng.choice([3, 10, 11, 40, 41, 42, 90, 139], size=(120, 2))
+    ys = rng.choice([0, 5, 6, 50, 70, 99], size=(120, 2))
+    x0, x1 = xs.min(axis=1), xs.max(axis=1) + 1  # pixel ranges [x0, x1), never empty
+    y0, y1 = ys.min(axis=1), ys.max(axis=1) + 1
+    boxes = np.column_stack([(x0 + x1) / 2, (y0 + y1) / 2, x1 - x0, y1 - y0]).astype(float)
+    boxes = np.vstack([boxes, boxes[:10], [[40.5, 50.5, 1.0, 1.0]]])
+    _weights_all_paths(image, boxes, r)
+    _weights_all_paths(image, boxes[rng.permutation(len(boxes))], r)
+
+
 def test_boxes_too_large_for_uint16_counts_fall_back(rng):
     image = _image(rng, 300, 300, 0.1)
     r = _reference_histogram(image, rng)

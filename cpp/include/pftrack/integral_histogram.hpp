@@ -2,7 +2,8 @@
 // integral histogram per group of boxes: T[y][x][k] = pixels of bin k above row y and left of
 // column x in the group's region, so a box's counts are four table rows, T[y1][x1] - T[y0][x1]
 // - T[y1][x0] + T[y0][x0], whatever its size (Porikli 2005). Counts are exact integers, equal to
-// the direct count, so the coefficients built from them are bit-identical.
+// the direct count, so the coefficients built from them are bit-identical. Only the rows and
+// columns the group's boxes start or end at are built (stop 70): no box reads any other.
 #pragma once
 
 #include <algorithm>
@@ -30,7 +31,8 @@ inline PixelRange bounding_union(const PixelRange& a, const PixelRange& b) {
 }
 
 /// Integral histogram of one rectangular region of a bin image, over the bins present in the
-/// region only (numbered compactly: fewer table entries to build and to read per box).
+/// region only (numbered compactly: fewer table entries to build and to read per box), at the
+/// corners of the boxes it is built for only.
 /// Entries are uint16 and wrap around; differences of four of them are still exact for any box
 /// of fewer than 65536 pixels (its counts are < 2^16), however large the region.
 class IntegralHistogram {
@@ -62,7 +64,7 @@ public:
 
     /// Numbers the bins present in `region` (background, bin -1, included when present).
     /// Returns the table's entries per pixel: a multiple of kLanes. A lazy image bins the
-    /// region here, for build() too (which reads the prepared region only).
+    /// region here, for build() too (which reads the prepared region only). Call build() next.
     int prepare(const BinImage& img, const PixelRange& region) {
         img.ensure(region.x0, region.x1, region.y0, region.y1);
         region_ = region;
@@ -96,52 +98,59 @@ public:
         return stride_;
     }
 
-    /// Fills the table of the prepared region: row 0 and column 0 are zero, and
-    /// T[y+1][x+1] = T[y][x+1] + (counts of the pixels (y, 0 .. x) of the region).
-    void build(const BinImage& img) {
+    /// Fills the table of the prepared region at the corners of the boxes `ranges[*m]`, m in
+    /// [m0, m1) (each inside the region) only: T[y][x] for the rows y and columns x some box
+    /// starts or ends at, numbered in order (row_of_, col_of_). Counts are kept from the first
+    /// corner row and column on: the pixels above or left of them are in all four of a box's
+    /// entries or in none, so every box's counts are the full table's. Each pixel adds 1 to its
+    /// column band's running count (between two corner columns), and only the corner rows'
+    /// entries are summed and written: the full table wrote (w + 1) x stride entries a row.
+    void build(const BinImage& img, const std::vector<PixelRange>& ranges, const Index* m0,
+               const Index* m1) {
         const Index w = region_.x1 - region_.x0, h = region_.y1 - region_.y0;
-        row_len_ = (w + 1) * stride_;
-        reserve_table(static_cast<size_t>((h + 1) * row_len_));
-        local_.resize(static_cast<size_t>(stride_));
+        corners(ranges, m0, m1, w, h);
+        const Index nx = static_cast<Index>(xs_.size()), ny = static_cast<Index>(ys_.size());
+        const int s = stride_;
+        row_len_ = nx * s;
+        reserve_table(static_cast<size_t>(ny * row_len_));
+        local_.resize(static_cast<size_t>(s));
+        bands_.resize(static_cast<size_t>(row_len_));
         std::uint16_t* t = table_.get();
         std::fill(t, t + row_len_, std::uint16_t(0));
-        std::vector<std::uint16_t>& run = local_;  // the running row histogram
+        if (nx == 0) return;
+        // band_of[x]: where pixel column x0 + x counts, band j (columns xs[j-1] .. xs[j]) at j s
+        // (Index: the sum with a bin's compact index needs no widening a pixel)
+        band_of_.resize(static_cast<size_t>(xs_.back() - xs_.front()));
+        for (Index j = 1; j < nx; ++j)
+            for (Index x = xs_[static_cast<size_t>(j - 1)]; x < xs_[static_cast<size_t>(j)]; ++x)
+                band_of_[static_cast<size_t>(x - xs_.front())] = j * s;
         const std::int16_t* local_of = local_of_.data() + 1;
-        const int s = stride_;
-#if defined(__SSE2__)
-        switch (s / kLanes) {  // the running row histogram in registers: up to 16 vectors
-            case 1: return build_rows<1>(img, w, h);
-            case 2: return build_rows<2>(img, w, h);
-            case 3: return build_rows<3>(img, w, h);
-            case 4: return build_rows<4>(img, w, h);
-            case 5: return build_rows<5>(img, w, h);
-            case 6: return build_rows<6>(img, w, h);
-            case 7: return build_rows<7>(img, w, h);
-            case 8: return build_rows<8>(img, w, h);
-            case 9: return build_rows<9>(img, w, h);
-            case 10: return build_rows<10>(img, w, h);
-            case 11: return build_rows<11>(img, w, h);
-            case 12: return build_rows<12>(img, w, h);
-            case 13: return build_rows<13>(img, w, h);
-            case 14: return build_rows<14>(img, w, h);
-            case 15: return build_rows<15>(img, w, h);
-            case 16: return build_rows<16>(img, w, h);
-            default: break;
-        }
-#endif
-        for (Index y = 0; y < h; ++y) {
-            const std::uint16_t* above = t + y * row_len_ + s;
-            std::uint16_t* cur = t + (y + 1) * row_len_;
-            std::fill(cur, cur + s, std::uint16_t(0));
-            cur += s;
-            std::fill(run.begin(), run.end(), std::uint16_t(0));
-            const std::int16_t* b = img.row(region_.y0 + y) + region_.x0;
-            for (Index x = 0; x < w; ++x, above += s, cur += s)
-                add_pixel(run.data(), local_of[b[x]], above, cur, s);
+        const Index* band_of = band_of_.data();
+        const Index cx0 = region_.x0 + xs_.front(), cw = xs_.back() - xs_.front();
+        std::uint16_t* band = bands_.data();
+        std::fill(band, band + row_len_, std::uint16_t(0));  // sum_bands zeroes what it read
+        for (Index i = 1; i < ny; ++i) {
+            for (Index y = ys_[static_cast<size_t>(i - 1)]; y < ys_[static_cast<size_t>(i)]; ++y) {
+                const std::int16_t* b = img.row(region_.y0 + y) + cx0;
+                Index x = 0;
+                for (; x + 4 <= cw; x += 4) {  // four a turn: the loop's own count and jump
+                    const Index l0 = band_of[x] + local_of[b[x]];
+                    const Index l1 = band_of[x + 1] + local_of[b[x + 1]];
+                    const Index l2 = band_of[x + 2] + local_of[b[x + 2]];
+                    const Index l3 = band_of[x + 3] + local_of[b[x + 3]];
+                    ++band[l0];  // mod 2^16, as every entry
+                    ++band[l1];
+                    ++band[l2];
+                    ++band[l3];
+                }
+                for (; x < cw; ++x) ++band[band_of[x] + local_of[b[x]]];
+            }
+            // T[i][j] = T[i-1][j] + the bands 1 .. j of the rows between the two corner rows
+            sum_bands(t + (i - 1) * row_len_, t + i * row_len_, nx);
         }
     }
 
-    /// Counts of the box `r` (inside the region, at most kMaxBoxPixels pixels) written to c[bin]
+    /// Counts of the box `r` (one of those build() was given, at most kMaxBoxPixels pixels) written to c[bin]
     /// for each bin present in the region, c[-1] for background; other entries are left alone.
     void box_counts(const PixelRange& r, std::int32_t* c) {
         box_counts_compact(r);
@@ -153,8 +162,11 @@ public:
     /// Counts of the box `r` (as box_counts) in compact form only, into present().counts;
     /// returns its background pixels (bin -1).
     std::int64_t box_counts_compact(const PixelRange& r) {
-        const Index x0 = r.x0 - region_.x0, x1 = r.x1 - region_.x0;
-        const Index y0 = r.y0 - region_.y0, y1 = r.y1 - region_.y0;
+        // frame column and row -> table column and row (corners of the boxes built for)
+        const Index x0 = col_of_[static_cast<size_t>(r.x0 - region_.x0)];
+        const Index x1 = col_of_[static_cast<size_t>(r.x1 - region_.x0)];
+        const Index y0 = row_of_[static_cast<size_t>(r.y0 - region_.y0)];
+        const Index y1 = row_of_[static_cast<size_t>(r.y1 - region_.y0)];
         const std::uint16_t* t = table_.get();
         const std::uint16_t* a = t + y0 * row_len_ + x0 * stride_;
         const std::uint16_t* b = t + y0 * row_len_ + x1 * stride_;
@@ -187,60 +199,91 @@ private:
         table_.reset(new std::uint16_t[table_capacity_]);  // default-initialised: not zeroed
     }
 
+    /// One corner row of the table: cur[j] = above[j] + (bands_ 1 .. j summed), cur[0] = 0;
+    /// bands_ is left zero for the next corner row (in the same pass: a memset call a corner
+    /// row cost more than the stores).
+    void sum_bands(const std::uint16_t* above, std::uint16_t* cur, Index nx) {
+        const int s = stride_;
 #if defined(__SSE2__)
-    /// build() with V vectors of bins: the running row histogram stays in V registers, and
-    /// pixel of compact bin l adds (lane == l) to each, a compare and a subtract per vector
-    /// (no dependency through memory from one pixel to the next).
-    template <int V>
-    void build_rows(const BinImage& img, Index w, Index h) {
-        const std::int16_t* local_of = local_of_.data() + 1;
-        __m128i lane[V];
-        for (int j = 0; j < V; ++j)
-            lane[j] = _mm_add_epi16(_mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7),
-                                    _mm_set1_epi16(static_cast<short>(j * kLanes)));
-        std::uint16_t* t = table_.get();
-        for (Index y = 0; y < h; ++y) {
-            const std::uint16_t* above = t + y * row_len_ + V * kLanes;
-            std::uint16_t* cur = t + (y + 1) * row_len_;
-            std::fill(cur, cur + V * kLanes, std::uint16_t(0));
-            cur += V * kLanes;
-            __m128i run[V];
-            for (int j = 0; j < V; ++j) run[j] = _mm_setzero_si128();
-            const std::int16_t* b = img.row(region_.y0 + y) + region_.x0;
-            for (Index x = 0; x < w; ++x, above += V * kLanes, cur += V * kLanes) {
-                const __m128i l = _mm_set1_epi16(local_of[b[x]]);
-                for (int j = 0; j < V; ++j) {
-                    run[j] = _mm_sub_epi16(run[j], _mm_cmpeq_epi16(lane[j], l));  // -(-1) = +1
-                    _mm_storeu_si128(reinterpret_cast<__m128i*>(cur + j * kLanes),
-                                     _mm_add_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(
-                                                       above + j * kLanes)),
-                                                   run[j]));
-                }
-            }
+        switch (s / kLanes) {  // the running sum in registers: up to 16 vectors
+            case 1: return sum_bands_in<1>(above, cur, nx);
+            case 2: return sum_bands_in<2>(above, cur, nx);
+            case 3: return sum_bands_in<3>(above, cur, nx);
+            case 4: return sum_bands_in<4>(above, cur, nx);
+            case 5: return sum_bands_in<5>(above, cur, nx);
+            case 6: return sum_bands_in<6>(above, cur, nx);
+            case 7: return sum_bands_in<7>(above, cur, nx);
+            case 8: return sum_bands_in<8>(above, cur, nx);
+            case 9: return sum_bands_in<9>(above, cur, nx);
+            case 10: return sum_bands_in<10>(above, cur, nx);
+            case 11: return sum_bands_in<11>(above, cur, nx);
+            case 12: return sum_bands_in<12>(above, cur, nx);
+            case 13: return sum_bands_in<13>(above, cur, nx);
+            case 14: return sum_bands_in<14>(above, cur, nx);
+            case 15: return sum_bands_in<15>(above, cur, nx);
+            case 16: return sum_bands_in<16>(above, cur, nx);
+            default: break;
         }
+#endif
+        std::fill(cur, cur + s, std::uint16_t(0));
+        std::uint16_t* run = local_.data();
+        std::fill(run, run + s, std::uint16_t(0));
+        std::uint16_t* band = bands_.data();
+        for (Index o = s; o < nx * s; o += s)
+            for (int k = 0; k < s; ++k) {
+                run[k] = static_cast<std::uint16_t>(run[k] + band[o + k]);
+                band[o + k] = 0;
+                cur[o + k] = static_cast<std::uint16_t>(above[o + k] + run[k]);
+            }
+    }
+
+#if defined(__SSE2__)
+    template <int V>
+    void sum_bands_in(const std::uint16_t* above, std::uint16_t* cur, Index nx) {
+        const __m128i zero = _mm_setzero_si128();
+        __m128i run[V];
+        for (int j = 0; j < V; ++j) {
+            run[j] = zero;
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(cur + j * kLanes), zero);
+        }
+        std::uint16_t* band = bands_.data();
+        for (Index o = V * kLanes; o < nx * V * kLanes; o += V * kLanes)
+            for (int j = 0; j < V; ++j) {
+                const Index k = o + j * kLanes;
+                auto* bk = reinterpret_cast<__m128i*>(band + k);
+                run[j] = _mm_add_epi16(run[j], _mm_loadu_si128(bk));
+                _mm_storeu_si128(bk, zero);
+                _mm_storeu_si128(reinterpret_cast<__m128i*>(cur + k),
+                                 _mm_add_epi16(run[j], _mm_loadu_si128(reinterpret_cast<const __m128i*>(above + k))));
+            }
     }
 #endif
 
-    // cur = above + run after run[l] += 1, over s entries.
-    static void add_pixel(std::uint16_t* run, int l, const std::uint16_t* above, std::uint16_t* cur,
-                          int s) {
-#if defined(__SSE2__)
-        // One vector add of a unit vector (a sliding window on kUnit) so that the loads of `run`
-        // below forward from vector stores of the same size (a scalar ++run[l] would stall them).
-        alignas(16) static const std::uint16_t kUnit[2 * kLanes] = {0, 0, 0, 0, 0, 0, 0, 0,
-                                                                    1, 0, 0, 0, 0, 0, 0, 0};
-        auto* chunk = reinterpret_cast<__m128i*>(run + (l & ~(kLanes - 1)));
-        _mm_storeu_si128(chunk, _mm_add_epi16(_mm_loadu_si128(chunk),
-                                              _mm_loadu_si128(reinterpret_cast<const __m128i*>(
-                                                  kUnit + kLanes - (l & (kLanes - 1))))));
-        for (int k = 0; k < s; k += kLanes)
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(cur + k),
-                             _mm_add_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(above + k)),
-                                           _mm_loadu_si128(reinterpret_cast<const __m128i*>(run + k))));
-#else
-        ++run[l];
-        for (int k = 0; k < s; ++k) cur[k] = static_cast<std::uint16_t>(above[k] + run[k]);
-#endif
+    /// xs_, ys_: the sorted distinct columns and rows (region-relative) the boxes start or end
+    /// at; col_of_, row_of_: a corner's table column and row (other entries are not read).
+    void corners(const std::vector<PixelRange>& ranges, const Index* m0, const Index* m1, Index w,
+                 Index h) {
+        col_of_.assign(static_cast<size_t>(w + 1), -1);
+        row_of_.assign(static_cast<size_t>(h + 1), -1);
+        for (const Index* m = m0; m != m1; ++m) {
+            const PixelRange& r = ranges[static_cast<size_t>(*m)];
+            col_of_[static_cast<size_t>(r.x0 - region_.x0)] = 0;
+            col_of_[static_cast<size_t>(r.x1 - region_.x0)] = 0;
+            row_of_[static_cast<size_t>(r.y0 - region_.y0)] = 0;
+            row_of_[static_cast<size_t>(r.y1 - region_.y0)] = 0;
+        }
+        number(col_of_, xs_);
+        number(row_of_, ys_);
+    }
+
+    /// Numbers the marked (0) entries of `of` in order, and lists them in `at`.
+    static void number(std::vector<Index>& of, std::vector<Index>& at) {
+        at.clear();
+        for (size_t v = 0; v < of.size(); ++v)
+            if (of[v] == 0) {
+                of[v] = static_cast<Index>(at.size());
+                at.push_back(static_cast<Index>(v));
+            }
     }
 
     int n_bins_;
@@ -254,7 +297,11 @@ private:
     std::vector<std::int16_t> bin_of_local_;  // compact index -> bin (-1: background)
     std::vector<std::int16_t> lanes_;        // the bins >= 0 present, by partial sum (present())
     std::vector<std::int16_t> lanes_local_;  // their compact indices
-    std::unique_ptr<std::uint16_t[]> table_;  // (h + 1) x (w + 1) x stride_ (of a larger buffer)
+    std::unique_ptr<std::uint16_t[]> table_;  // corner rows x corner columns x stride_ (of a larger buffer)
+    std::vector<Index> xs_, ys_;             // the corner columns and rows (region-relative)
+    std::vector<Index> col_of_, row_of_;     // region column / row -> table column / row
+    std::vector<Index> band_of_;             // column (from xs_[0]) -> its band's first entry
+    std::vector<std::uint16_t> bands_;       // one corner row band's counts, by column band
     size_t table_capacity_ = 0;
     std::vector<std::uint16_t> local_;       // one box's (or one row's running) compact counts
 };
@@ -399,7 +446,7 @@ inline void for_each_range_count(const BinImage& img, const std::vector<PixelRan
             for (const Index* m = m0; m != m1; ++m) direct(*m, ranges[static_cast<size_t>(*m)]);
             continue;
         }
-        table.build(img);
+        table.build(img, ranges, m0, m1);
         present = table.present();
         if constexpr (kCompact) {
             // no copy over every bin: from_counts(i, total, present, first box of the region)
