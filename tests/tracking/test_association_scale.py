@@ -2,9 +2,9 @@
 
 ``first_of_twins``, ``MultiObjectTracker._beside`` and ``associate`` now work from the pairs of
 boxes that overlap (``_core.overlap_pairs``) and an assignment that never makes the padded
-matrix (``_core.padded_assignment``). Each is held here to the dense code it replaced, copied
-below as it was on main at stop 69, on random boxes with ties, zero areas and identical boxes:
-the same results, exactly.
+matrix (``_core.padded_assignment``). Each is held here to the dense code it replaced
+(tests/reference/association.py, as it was on main at stop 69), on random boxes with ties,
+zero areas and identical boxes: the same results, exactly.
 """
 
 from __future__ import annotations
@@ -20,8 +20,9 @@ from hypothesis import strategies as st
 from pftrack import _core
 from pftrack.boxes import _iou_matrix, _overlap_pairs
 from pftrack.tracking import AssociationConfig, association
-from pftrack.tracking.association import FORBIDDEN, _padding, associate, colour_product
+from pftrack.tracking.association import FORBIDDEN, _padding, associate
 from pftrack.tracking.tracker import MultiObjectTracker
+from tests.reference import association as dense
 
 
 def _random_boxes(rng: np.random.Generator, n: int, grid: bool) -> np.ndarray:
@@ -38,68 +39,6 @@ def _random_boxes(rng: np.random.Generator, n: int, grid: bool) -> np.ndarray:
         copies = rng.random(n) < 0.2
         b[copies] = b[rng.integers(0, n, copies.sum())]
     return b
-
-
-# --- the dense code of stop 69 ------------------------------------------------------------------
-
-
-def _dense_first_of_twins(boxes, labels, candidates, explained, overlap):  # type: ignore[no-untyped-def]
-    if overlap is None or len(boxes) < 2 or not len(candidates):
-        return list(candidates)
-    rows = np.asarray(candidates, dtype=np.intp)
-    twins = (_iou_matrix(boxes[rows, :4], boxes[:, :4]) > overlap) & (
-        labels[rows][:, None] == labels[None, :]
-    )
-    explained = explained.copy()
-    kept = []
-    for k, di in enumerate(candidates):
-        if twins[k, explained].any():
-            continue
-        explained[di] = True
-        kept.append(di)
-    return kept
-
-
-def _dense_beside(tracks, boxes, labels, unmatched, overlap):  # type: ignore[no-untyped-def]
-    if not len(unmatched) or not tracks:
-        return set()
-    rows = np.asarray(unmatched, dtype=np.intp)
-    iou = _iou_matrix(boxes[rows, :4], np.array([t.box for t in tracks]))
-    same = labels[rows][:, None] == np.array([t.cls for t in tracks])[None, :]
-    hit = ((iou > overlap) & same).any(axis=1)
-    return set(rows[hit].tolist())
-
-
-def _dense_associate(track_boxes, heights, coasted, references, boxes, hists, config, allowed):  # type: ignore[no-untyped-def]
-    nt, nd = len(track_boxes), len(boxes)
-    if nt == 0 or nd == 0:
-        return association.Association([], list(range(nt)), list(range(nd)))
-    rho = colour_product(np.sqrt(references), np.sqrt(hists).T)
-    cost = _core.association_cost(
-        track_boxes, heights, coasted, rho, boxes, config.match_distance,
-        config.colour_weight, config.match_iou, FORBIDDEN,
-    )  # fmt: skip
-    if allowed is not None:
-        cost = np.where(allowed, cost, FORBIDDEN)
-    if math.isfinite(config.unmatched_cost):
-        padded = _padding(nt, nd, config.unmatched_cost).copy()
-        padded[:nt, :nd] = cost
-        cost_in = padded
-    else:
-        cost_in = np.ascontiguousarray(cost)
-    rows, cols = _core.linear_sum_assignment(cost_in)
-    matches = [
-        (r, c)
-        for r, c in zip(rows.tolist(), cols.tolist(), strict=True)
-        if r < nt and c < nd and cost[r, c] < FORBIDDEN
-    ]
-    taken_t = {r for r, _ in matches}
-    taken_d = {c for _, c in matches}
-    return association.Association(
-        matches,
-        [i for i in range(nt) if i not in taken_t],
-        [j for j in range(nd) if j not in taken_d],
-    )
 
 
 # --- overlap_pairs -------------------------------------------------------------------------------
@@ -173,7 +112,7 @@ def test_first_of_twins_is_the_dense_rule(seed: int, n: int, grid: bool, overlap
     candidates = rng.permutation(n)[: rng.integers(0, n + 1)].tolist()
     explained = rng.random(n) < 0.2
     before = explained.copy()
-    want = _dense_first_of_twins(boxes, labels, candidates, explained, overlap)
+    want = dense.first_of_twins(boxes, labels, candidates, explained, overlap)
     got = association.first_of_twins(boxes, labels, candidates, explained, overlap)
     assert got == want
     np.testing.assert_array_equal(explained, before)  # not changed
@@ -193,7 +132,7 @@ def test_beside_is_the_dense_rule(seed: int, n: int, nt: int, grid: bool) -> Non
     cfg = SimpleNamespace(lifecycle=SimpleNamespace(birth_overlap=0.3))
     me = SimpleNamespace(tracks=tracks)
     got = MultiObjectTracker._beside(me, boxes, labels, unmatched, cfg)  # type: ignore[arg-type]
-    assert got == _dense_beside(tracks, boxes, labels, unmatched, 0.3)
+    assert got == dense.beside(tracks, boxes, labels, unmatched, 0.3)
 
 
 @settings(max_examples=200, deadline=None)
@@ -218,7 +157,7 @@ def test_associate_is_the_dense_assignment(
     config = AssociationConfig(unmatched_cost=tau)
     allowed = rng.random((nt, nd)) < 0.7 if classes else None
     args = (tracks, heights, coasted, references, boxes, hists, config, allowed)
-    assert associate(*args) == _dense_associate(*args)
+    assert associate(*args) == dense.associate(*args)
 
 
 @settings(max_examples=200, deadline=None)
@@ -266,12 +205,12 @@ def test_a_crowd_of_boxes_is_associated_as_the_dense_code_does() -> None:
     args = (tracks, tracks[:, 3], rng.integers(0, 5, 600), references, boxes, hists,
             AssociationConfig(), None)  # fmt: skip
     got = associate(*args)
-    assert got == _dense_associate(*args)
+    assert got == dense.associate(*args)
     assert len(got.matches) > 50  # the crowd is associated, not left alone
     labels = np.zeros(900, np.int64)
     candidates = got.unmatched_detections
     explained = np.zeros(900, np.bool_)
     explained[[d for _, d in got.matches]] = True
     assert association.first_of_twins(boxes, labels, candidates, explained, 0.3) == (
-        _dense_first_of_twins(boxes, labels, candidates, explained, 0.3)
+        dense.first_of_twins(boxes, labels, candidates, explained, 0.3)
     )

@@ -133,15 +133,48 @@ inline std::pair<Eigen::VectorXi, Eigen::VectorXi> padded_assignment(
     std::vector<double> u(n, 0.0), v(nc, 0.0), shortest(nc);
     std::vector<Index> path(nc, -1), col4row(n, -1), row4col(nc, -1), remaining(nc);
     std::vector<char> SR(n), SC(nc);
-    for (Index cur = 0; cur < n; ++cur) {
-        double min_val = 0.0;
-        Index i = cur;
-        Index num_remaining = nc;
-        for (Index it = 0; it < nc; ++it) remaining[it] = nc - it - 1;
+    // The search, skipping the entries equal to `forbidden` (most of them): each scanned row
+    // updates only its other entries (a track's gated pairs and its own padding column; a
+    // padding row's detection and the T padding columns), and the lowest column is sought
+    // among the columns so updated, in the order of `remaining` (its position `pos`), by the
+    // rule of the full scan. A skipped entry's value min_val + forbidden - u[i] - v[j] is at
+    // least bound = (min_val + forbidden - u[i]) - vmax (rounding is monotone; vmax >= every
+    // v[j]); while every column taken is below the least such bound, the full scan would have
+    // taken the same columns with the same values and paths (a skipped entry is never the
+    // lowest nor tied with it), so the result is the same. Otherwise that search is made again
+    // by the full scan: the sparse one changed nothing that outlives a search.
+    std::vector<Index> first(static_cast<std::size_t>(nt) + 1, 0), gated;
+    std::vector<double> gated_cost;
+    for (Index i = 0; i < nt; ++i) {
+        for (Index j = 0; j < nd; ++j)
+            if (cost(i, j) != forbidden) {
+                gated.push_back(j);
+                gated_cost.push_back(cost(i, j));
+            }
+        gated.push_back(nd + i);
+        gated_cost.push_back(tau);
+        first[static_cast<std::size_t>(i) + 1] = static_cast<Index>(gated.size());
+    }
+    std::vector<Index> pos(nc), touched;
+    std::vector<char> is_touched(nc, 0);
+    double vmax = 0.0;  // >= every v[j] (v starts at 0)
+    double min_val = 0.0;
+    Index sink = -1;
+    auto start = [&](Index& num_remaining) {
+        num_remaining = nc;
+        for (Index it = 0; it < nc; ++it) {
+            remaining[it] = nc - it - 1;
+            pos[nc - it - 1] = it;
+        }
         std::fill(SR.begin(), SR.end(), 0);
         std::fill(SC.begin(), SC.end(), 0);
         std::fill(shortest.begin(), shortest.end(), inf);
-        Index sink = -1;
+        min_val = 0.0;
+        sink = -1;
+    };
+    auto full_search = [&](Index cur) {
+        Index i = cur, num_remaining = 0;
+        start(num_remaining);
         while (sink == -1) {
             Index index = -1;
             double lowest = inf;
@@ -169,11 +202,82 @@ inline std::pair<Eigen::VectorXi, Eigen::VectorXi> padded_assignment(
             SC[j] = 1;
             remaining[index] = remaining[--num_remaining];
         }
+    };
+    auto sparse_search = [&](Index cur) -> bool {
+        Index i = cur, num_remaining = 0;
+        start(num_remaining);
+        for (Index j : touched) is_touched[j] = 0;
+        touched.clear();
+        double bound = inf, top = -inf;
+        auto update = [&](Index j, double c) {
+            if (SC[j]) return;  // no longer in `remaining`
+            const double r = min_val + c - u[i] - v[j];
+            if (r < shortest[j]) {
+                path[j] = i;
+                shortest[j] = r;
+            }
+            if (!is_touched[j]) {
+                is_touched[j] = 1;
+                touched.push_back(j);
+            }
+        };
+        while (sink == -1) {
+            SR[i] = 1;
+            bound = std::min(bound, min_val + forbidden - u[i] - vmax);
+            if (i < nt) {
+                for (Index k = first[i]; k < first[i + 1]; ++k) update(gated[k], gated_cost[k]);
+            } else {
+                update(i - nt, tau);
+                for (Index j = nd; j < nc; ++j) update(j, 0.0);
+            }
+            // the lowest value; among its columns the last free one in `remaining`, else the
+            // first one (the full scan's rule)
+            double lowest = inf;
+            Index at = -1, free_at = -1, t_at = -1;
+            for (std::size_t t = 0; t < touched.size(); ++t) {
+                const Index j = touched[t];
+                const double s_j = shortest[j];
+                if (s_j < lowest) {
+                    lowest = s_j;
+                    at = pos[j];
+                    free_at = row4col[j] == -1 ? pos[j] : -1;
+                } else if (s_j == lowest) {
+                    at = std::min(at, pos[j]);
+                    if (row4col[j] == -1) free_at = std::max(free_at, pos[j]);
+                }
+            }
+            if (at < 0) return false;  // nothing but skipped entries
+            const Index index = free_at >= 0 ? free_at : at;
+            min_val = lowest;
+            top = std::max(top, lowest);
+            if (!(top < bound)) return false;  // a skipped entry might be the lowest
+            const Index j = remaining[index];
+            for (t_at = 0; touched[static_cast<std::size_t>(t_at)] != j; ++t_at) {
+            }
+            touched[static_cast<std::size_t>(t_at)] = touched.back();
+            touched.pop_back();
+            is_touched[j] = 0;
+            if (row4col[j] == -1)
+                sink = j;
+            else
+                i = row4col[j];
+            SC[j] = 1;
+            const Index moved = remaining[--num_remaining];
+            remaining[index] = moved;
+            pos[moved] = index;
+        }
+        return true;
+    };
+    for (Index cur = 0; cur < n; ++cur) {
+        if (!sparse_search(cur)) full_search(cur);
         u[cur] += min_val;
         for (Index r = 0; r < n; ++r)
             if (SR[r] && r != cur) u[r] += min_val - shortest[col4row[r]];
         for (Index j = 0; j < nc; ++j)
-            if (SC[j]) v[j] -= min_val - shortest[j];
+            if (SC[j]) {
+                v[j] -= min_val - shortest[j];
+                vmax = std::max(vmax, v[j]);
+            }
         Index j = sink;
         while (true) {
             const Index r = path[j];
