@@ -18,6 +18,7 @@ void register_blobs(py::module_& m);
 void register_text(py::module_& m);
 void register_regions(py::module_& m);
 void register_tracks(py::module_& m);
+void register_overlap(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "pftrack's C++ kernels (private: use the pftrack package)";
@@ -35,4 +36,5 @@ PYBIND11_MODULE(_core, m) {
     register_text(m);
     register_regions(m);
     register_tracks(m);
+    register_overlap(m);
 }

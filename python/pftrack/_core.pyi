@@ -285,6 +285,10 @@ def linear_sum_assignment(cost: _F64) -> tuple[_I32, _I32]: ...  # rows ascendin
 def sparse_assignment(
     r: ArrayLike, c: ArrayLike, cost: ArrayLike, n_ends: int, n_starts: int, unjoined: float
 ) -> tuple[NDArray[np.int64], NDArray[np.int64]]: ...  # ends ascending
+def overlap_pairs(
+    a: ArrayLike, b: ArrayLike
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]: ...  # (i, j) increasing
+def padded_assignment(cost: ArrayLike, tau: float, forbidden: float) -> tuple[_I32, _I32]: ...
 
 # --- box refinement: boxes (K, 4) left, top, w, h; mask (H, W) uint8 or bool -> (K, 4) -----
 def refine_boxes(

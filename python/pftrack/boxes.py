@@ -15,8 +15,9 @@ the unchecked ``_iou_matrix``, ``_intersection_matrix``, ``_iou_rows``, ``_to_cx
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
+from pftrack import _core
 from pftrack._check import first_bad_box, real_array
 from pftrack._typing import F64
 
@@ -167,6 +168,27 @@ def _iou_matrix(a: ArrayLike, b: ArrayLike) -> F64:
     a = np.asarray(a, dtype=np.float64).reshape(-1, 4)
     b = np.asarray(b, dtype=np.float64).reshape(-1, 4)
     return _iou(a[:, None, :], b[None, :, :])
+
+
+def _overlap_pairs(a: ArrayLike, b: ArrayLike) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """Pairs ``(i, j)`` of boxes ``a[i]``, ``b[j]`` whose intersection can have an area > 0.
+
+    Every pair whose :func:`_iou_matrix` entry is > 0 is among them (their interiors meet in x
+    and in y), in increasing ``(i, j)`` order; the caller computes their IoU with
+    :func:`_iou_rows`, the same floats as the dense matrix's. Sort-and-sweep in the core
+    (``_core.overlap_pairs``): time and memory grow with the boxes and the pairs that meet, not
+    with ``len(a) * len(b)``. Unchecked, as :func:`_iou_matrix`.
+
+    References
+    ----------
+    .. [1] Baraff, D. (1992). Dynamic simulation of non-penetrating rigid bodies (sweep and
+       prune), PhD thesis, Cornell University.
+    """
+    i, j = _core.overlap_pairs(
+        np.ascontiguousarray(a, dtype=np.float64).reshape(-1, 4),
+        np.ascontiguousarray(b, dtype=np.float64).reshape(-1, 4),
+    )
+    return i.astype(np.intp, copy=False), j.astype(np.intp, copy=False)
 
 
 def iou_xywh_rows(a: ArrayLike, b: ArrayLike) -> F64:

@@ -255,6 +255,21 @@ def _sparse_assignment(draw: st.DrawFn) -> Any:
     )
 
 
+def _overlap_pairs() -> st.SearchStrategy[Any]:
+    return call(_core.overlap_pairs, maybe(boxes()), maybe(boxes()))
+
+
+def _padded_assignment() -> st.SearchStrategy[Any]:
+    return st.tuples(N, N).flatmap(
+        lambda td: call(
+            _core.padded_assignment,
+            maybe(floats_array(td, -10, 1e6)),
+            maybe(fl(-1e6, 1e6)),
+            maybe(fl(0, 1e6)),
+        )
+    )
+
+
 def _mh() -> st.SearchStrategy[Any]:
     def kw(n: int) -> dict[str, st.SearchStrategy[Any]]:
         k = _step_kwargs(n)
@@ -636,6 +651,8 @@ TARGETS: list[Target] = [
     Target("linear_sum_assignment", _assignment()),
     Target("association_cost", _association_cost()),
     Target("sparse_assignment", _sparse_assignment()),
+    Target("overlap_pairs", _overlap_pairs()),
+    Target("padded_assignment", _padded_assignment()),
     Target(
         "refine_boxes",
         call(

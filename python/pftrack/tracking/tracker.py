@@ -39,7 +39,7 @@ from pftrack._check import (
 from pftrack._core import BinnedImage
 from pftrack._typing import F64, RngLike
 from pftrack._warn import Held, warn
-from pftrack.boxes import _iou_matrix, _to_cxcywh
+from pftrack.boxes import _iou_rows, _overlap_pairs, _to_cxcywh
 from pftrack.detection import (
     FrameDetector,
     check_detections,
@@ -935,10 +935,14 @@ class MultiObjectTracker:
         if life.birth_overlap is None or not len(unmatched) or not self.tracks:
             return set()
         rows = np.asarray(unmatched, dtype=np.intp)
-        iou = _iou_matrix(boxes[rows, :4], np.array([t.box for t in self.tracks]))
-        same = labels[rows][:, None] == np.array([t.cls for t in self.tracks])[None, :]
-        hit = ((iou > life.birth_overlap) & same).any(axis=1)
-        return set(rows[hit].tolist())
+        # over the pairs that overlap at all (an IoU above birth_overlap > 0 needs an
+        # intersection), not a dense (unmatched, tracks) IoU matrix: the same IoUs of the same
+        # pairs, in memory that grows with the pairs (10 000 boxes in a frame, stop 70)
+        track_boxes = np.array([t.box for t in self.tracks])
+        k, j = _overlap_pairs(boxes[rows, :4], track_boxes)
+        same = labels[rows[k]] == np.array([t.cls for t in self.tracks], np.int64)[j]
+        hit = (_iou_rows(boxes[rows[k], :4], track_boxes[j]) > life.birth_overlap) & same
+        return set(rows[k[hit]].tolist())
 
     def _measure_speeds(
         self, followed: list[tuple[int, int]], boxes: F64, cfg: TrackerConfig
