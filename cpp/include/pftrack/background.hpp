@@ -17,6 +17,13 @@
 #include "hsv.hpp"
 #include "types.hpp"
 
+// HsvLut::bins_at's AVX2 look-ups (table gathers), chosen at run time: GCC's generic tuning
+// never emits gathers from the plain loop, which is the fallback.
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
+#define PFTRACK_LUT_GATHER 1
+#include <immintrin.h>
+#endif
+
 namespace pftrack {
 
 /// `hsv_bin_of` as table look-ups, without branches: identical results (tests check all 2^24
@@ -41,7 +48,8 @@ public:
                         : static_cast<std::uint32_t>(grey0_ + vb);
             }
         }
-        hue_.assign(3 * kHueStride, 0);
+        // 3 bytes past the last entry: the AVX2 look-up reads 4 bytes at each entry
+        hue_.assign(3 * kHueStride + 3, 0);
         for (int sector = 0; sector < 3; ++sector)
             for (int d = 1; d < 256; ++d)
                 for (int num = -d; num <= d; ++num) {
@@ -68,6 +76,18 @@ public:
         return static_cast<int>((e & 0xffffu) + hue_[static_cast<size_t>(hue)] * (e >> 16));
     }
 
+    /// `bin_at(sat[x], hue[x])` of n pixels into `out` (`hsv_row_indices`'s indices): eight
+    /// pixels a step by AVX2 table gathers where the CPU has them (the same integers), else
+    /// one by one. The full-frame and the lazy bins of `hsv_bins_image` (not
+    /// `BackgroundModel::apply`'s fused bins).
+    void bins_at(Index n, const std::int32_t* sat, const std::int32_t* hue, std::int16_t* out) const {
+        Index x = 0;
+#ifdef PFTRACK_LUT_GATHER
+        if (__builtin_cpu_supports("avx2")) x = bins_at_avx2(n, sat, hue, out);
+#endif
+        for (; x < n; ++x) out[x] = static_cast<std::int16_t>(bin_at(sat[x], hue[x]));
+    }
+
     int bin(int b, int g, int r) const {
         const int mx = std::max(r, std::max(g, b));
         const int mn = std::min(r, std::min(g, b));
@@ -81,6 +101,32 @@ public:
     static constexpr int kHueStride = 256 * 256;  // d * d + (num + d) < 256^2 for d < 256
 
 private:
+#ifdef PFTRACK_LUT_GATHER
+    /// `bins_at` of the first n - n % 8 pixels (returned): per 8, one gather from sat_ (its
+    /// 32-bit entries) and one from hue_ (4 bytes at each entry, the low one kept), then
+    /// bin_at's arithmetic in 32-bit lanes (bins < 2^15: the signed pack keeps them).
+    __attribute__((target("avx2"))) Index bins_at_avx2(Index n, const std::int32_t* sat,
+                                                       const std::int32_t* hue,
+                                                       std::int16_t* out) const {
+        const auto* s_tab = reinterpret_cast<const int*>(sat_.data());
+        const auto* h_tab = reinterpret_cast<const int*>(hue_.data());
+        const __m256i low16 = _mm256_set1_epi32(0xffff), low8 = _mm256_set1_epi32(0xff);
+        Index x = 0;
+        for (; x + 8 <= n; x += 8) {
+            const __m256i si = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(sat + x));
+            const __m256i hi = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(hue + x));
+            const __m256i e = _mm256_i32gather_epi32(s_tab, si, 4);
+            const __m256i h = _mm256_and_si256(_mm256_i32gather_epi32(h_tab, hi, 1), low8);
+            const __m256i b = _mm256_add_epi32(_mm256_and_si256(e, low16),
+                                               _mm256_mullo_epi32(h, _mm256_srli_epi32(e, 16)));
+            // packs works per 128-bit lane: 64-bit quarters 0 and 2 hold pixels 0-3 and 4-7
+            const __m256i p = _mm256_permute4x64_epi64(_mm256_packs_epi32(b, b), 0x08);
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(out + x), _mm256_castsi256_si128(p));
+        }
+        return x;
+    }
+#endif
+
     int grey0_;                     // first grey bin, n_h * n_s
     std::vector<std::uint32_t> sat_;  // [max * 256 + min] -> n_s << 16 | saturation bin if a
                                       // colour pixel, else the grey bin n_h n_s + value bin
@@ -819,9 +865,7 @@ inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index row
         const std::uint8_t* px = bgr + y * row_stride;
         if (mask == nullptr) {
             detail::hsv_row_indices(cols, px, si.data(), hi.data());
-            for (Index x = 0; x < cols; ++x)
-                o[x] = static_cast<std::int16_t>(lut.bin_at(si[static_cast<size_t>(x)],
-                                                            hi[static_cast<size_t>(x)]));
+            lut.bins_at(cols, si.data(), hi.data(), o);
             continue;
         }
         const std::uint8_t* m = mask + y * mask_stride;
