@@ -45,6 +45,39 @@ def test_lut_bins_equal_hsv_bins_on_every_colour():
         assert not mask.any()  # the first frame initialises the background
 
 
+def test_full_frame_bins_of_every_colour_one_by_one():
+    # Four pixels a row: every pixel goes through the table look-ups' one-by-one loop, which
+    # wider rows use only for their last width % 8 pixels (test above: 8 at a time).
+    v = np.arange(1 << 24, dtype=np.uint32)
+    img = np.stack([v & 255, (v >> 8) & 255, v >> 16], axis=-1).astype(np.uint8)
+    kw = {"n_h": 8, "n_s": 4, "n_v": 3, "s_min": 0.25, "v_min": 0.05}
+    bins = _core.hsv_bins(img.reshape(-1, 4, 3), **kw).bins.reshape(-1)
+    for start in range(0, 1 << 24, 1 << 21):
+        np.testing.assert_array_equal(
+            bins[start : start + (1 << 21)],
+            hsv_bin_reference(img[None, start : start + (1 << 21)], **kw)[0],
+        )
+
+
+@pytest.mark.parametrize("lazy", [False, True])
+def test_full_frame_bins_at_every_row_tail(lazy):
+    # Rows of 1-75 pixels: 8 at a time, then the last 0-7 one by one, against NumPy. Lazy, a
+    # box in the last 32-column tile is read first, so that tile is binned alone (a rectangle
+    # of 1-32 columns at x 32 or 64), then the rest by `.bins`.
+    rng = np.random.default_rng(11)
+    for cols in range(1, 76):
+        img = rng.integers(0, 256, size=(5, cols, 3), dtype=np.uint8)
+        img[0, : cols // 2] = rng.integers(0, 256, size=3)  # a flat run
+        img[1] = img[1].min(axis=-1, keepdims=True)  # grey pixels
+        want = hsv_bin_reference(img)
+        got = _core.hsv_bins(img, lazy=lazy)
+        if lazy:
+            x0 = (cols - 1) // 32 * 32
+            _core.box_histograms(got, np.array([[(x0 + cols) / 2, 2.5, cols - x0, 5]]))
+            assert got.tiles_pending == (cols - 1) // 32
+        np.testing.assert_array_equal(got.bins, want)
+
+
 def test_hsv_reference_matches_core_on_random_pixels():
     img = np.random.default_rng(3).integers(0, 256, size=(64, 64, 3), dtype=np.uint8)
     np.testing.assert_array_equal(hsv_bin_reference(img), _core.hsv_bins(img).bins)

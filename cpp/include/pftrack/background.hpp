@@ -17,6 +17,13 @@
 #include "hsv.hpp"
 #include "types.hpp"
 
+// HsvLut::bins_of_row's AVX2 pass (byte shuffles, table gathers), chosen at run time: GCC's
+// generic tuning never emits gathers from the plain loops, which are the fallback.
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
+#define PFTRACK_LUT_GATHER 1
+#include <immintrin.h>
+#endif
+
 namespace pftrack {
 
 /// `hsv_bin_of` as table look-ups, without branches: identical results (tests check all 2^24
@@ -41,7 +48,8 @@ public:
                         : static_cast<std::uint32_t>(grey0_ + vb);
             }
         }
-        hue_.assign(3 * kHueStride, 0);
+        // 3 bytes past the last entry: the AVX2 look-up reads 4 bytes at each entry
+        hue_.assign(3 * kHueStride + 3, 0);
         for (int sector = 0; sector < 3; ++sector)
             for (int d = 1; d < 256; ++d)
                 for (int num = -d; num <= d; ++num) {
@@ -68,6 +76,24 @@ public:
         return static_cast<int>((e & 0xffffu) + hue_[static_cast<size_t>(hue)] * (e >> 16));
     }
 
+    /// `bin` of each of the n pixels of a row of BGR bytes into `out`, where the CPU has AVX2:
+    /// eight pixels a step, the table indices in 32-bit integer lanes (the same integers as
+    /// `hsv_row_indices`' exact floats) and table gathers, one pass with no index buffers;
+    /// reads the row's 3 n bytes and no more. Returns false (nothing written) without AVX2:
+    /// the caller then takes `hsv_row_indices` and `bin_at`.
+    bool bins_of_row(Index n, const std::uint8_t* px, std::int16_t* out) const {
+#ifdef PFTRACK_LUT_GATHER
+        if (!__builtin_cpu_supports("avx2")) return false;
+        Index x = bins_of_row_avx2(n, px, out);
+        for (; x < n; ++x)
+            out[x] = static_cast<std::int16_t>(bin(px[3 * x], px[3 * x + 1], px[3 * x + 2]));
+        return true;
+#else
+        (void)n, (void)px, (void)out;
+        return false;
+#endif
+    }
+
     int bin(int b, int g, int r) const {
         const int mx = std::max(r, std::max(g, b));
         const int mn = std::min(r, std::min(g, b));
@@ -81,6 +107,74 @@ public:
     static constexpr int kHueStride = 256 * 256;  // d * d + (num + d) < 256^2 for d < 256
 
 private:
+#ifdef PFTRACK_LUT_GATHER
+    /// `bin_at` of 8 pixels' table indices: one gather from sat_ (its 32-bit entries) and one
+    /// from hue_ (4 bytes at each entry, the low one kept), then bin_at's arithmetic in 32-bit
+    /// lanes.
+    __attribute__((target("avx2"))) __m256i bins8_avx2(__m256i si, __m256i hi) const {
+        const auto* s_tab = reinterpret_cast<const int*>(sat_.data());
+        const auto* h_tab = reinterpret_cast<const int*>(hue_.data());
+        const __m256i e = _mm256_i32gather_epi32(s_tab, si, 4);
+        const __m256i h =
+            _mm256_and_si256(_mm256_i32gather_epi32(h_tab, hi, 1), _mm256_set1_epi32(0xff));
+        return _mm256_add_epi32(_mm256_and_si256(e, _mm256_set1_epi32(0xffff)),
+                                _mm256_mullo_epi32(h, _mm256_srli_epi32(e, 16)));
+    }
+
+    /// `bins_of_row` of the first n - n % 8 pixels (returned). Per 8 pixels, their 24 bytes
+    /// (a 16-byte and an 8-byte load: nothing past them is read) are split into B, G, R lanes
+    /// by byte shuffles; then `HsvLut::bin`'s integers: sat = max 256 + min, and hue = sector
+    /// 65536 + d d + num + d with r tested first, then g (ties to the earlier channel).
+    __attribute__((target("avx2"))) Index bins_of_row_avx2(Index n, const std::uint8_t* px,
+                                                           std::int16_t* out) const {
+        // byte k of the 24 is channel k % 3 of pixel k / 3: bytes 0-15 in `lo`, 16-23 in `hi`
+        const __m128i b_lo = _mm_setr_epi8(0, 3, 6, 9, 12, 15, -1, -1, -1, -1, -1, -1, -1, -1,
+                                           -1, -1);
+        const __m128i b_hi = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, 2, 5, -1, -1, -1, -1, -1, -1,
+                                           -1, -1);
+        const __m128i g_lo = _mm_setr_epi8(1, 4, 7, 10, 13, -1, -1, -1, -1, -1, -1, -1, -1, -1,
+                                           -1, -1);
+        const __m128i g_hi = _mm_setr_epi8(-1, -1, -1, -1, -1, 0, 3, 6, -1, -1, -1, -1, -1, -1,
+                                           -1, -1);
+        const __m128i r_lo = _mm_setr_epi8(2, 5, 8, 11, 14, -1, -1, -1, -1, -1, -1, -1, -1, -1,
+                                           -1, -1);
+        const __m128i r_hi = _mm_setr_epi8(-1, -1, -1, -1, -1, 1, 4, 7, -1, -1, -1, -1, -1, -1,
+                                           -1, -1);
+        const __m256i stride1 = _mm256_set1_epi32(kHueStride),
+                      stride2 = _mm256_set1_epi32(2 * kHueStride);
+        Index x = 0;
+        for (; x + 8 <= n; x += 8) {
+            const std::uint8_t* p = px + 3 * x;
+            const __m128i lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+            const __m128i hi = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p + 16));
+            const __m256i b = _mm256_cvtepu8_epi32(
+                _mm_or_si128(_mm_shuffle_epi8(lo, b_lo), _mm_shuffle_epi8(hi, b_hi)));
+            const __m256i g = _mm256_cvtepu8_epi32(
+                _mm_or_si128(_mm_shuffle_epi8(lo, g_lo), _mm_shuffle_epi8(hi, g_hi)));
+            const __m256i r = _mm256_cvtepu8_epi32(
+                _mm_or_si128(_mm_shuffle_epi8(lo, r_lo), _mm_shuffle_epi8(hi, r_hi)));
+            const __m256i mx = _mm256_max_epi32(r, _mm256_max_epi32(g, b));
+            const __m256i mn = _mm256_min_epi32(r, _mm256_min_epi32(g, b));
+            const __m256i is_r = _mm256_cmpeq_epi32(mx, r), is_g = _mm256_cmpeq_epi32(mx, g);
+            // num = g - b (max is r), else b - r (max is g), else r - g; sector 65536 likewise
+            const __m256i num = _mm256_blendv_epi8(
+                _mm256_blendv_epi8(_mm256_sub_epi32(r, g), _mm256_sub_epi32(b, r), is_g),
+                _mm256_sub_epi32(g, b), is_r);
+            const __m256i sector =
+                _mm256_andnot_si256(is_r, _mm256_blendv_epi8(stride2, stride1, is_g));
+            const __m256i d = _mm256_sub_epi32(mx, mn);
+            const __m256i si = _mm256_or_si256(_mm256_slli_epi32(mx, 8), mn);
+            const __m256i hu = _mm256_add_epi32(
+                _mm256_add_epi32(sector, _mm256_mullo_epi32(d, d)), _mm256_add_epi32(num, d));
+            const __m256i v = bins8_avx2(si, hu);  // bins < 2^15: the signed pack keeps them
+            // packs works per 128-bit lane: 64-bit quarters 0 and 2 hold pixels 0-3 and 4-7
+            const __m256i pk = _mm256_permute4x64_epi64(_mm256_packs_epi32(v, v), 0x08);
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(out + x), _mm256_castsi256_si128(pk));
+        }
+        return x;
+    }
+#endif
+
     int grey0_;                     // first grey bin, n_h * n_s
     std::vector<std::uint32_t> sat_;  // [max * 256 + min] -> n_s << 16 | saturation bin if a
                                       // colour pixel, else the grey bin n_h n_s + value bin
@@ -799,9 +893,10 @@ PFTRACK_VECTOR_CLONES static void mask_bins_row(const std::int16_t* __restrict s
 }  // namespace detail
 
 /// `HsvLut::bin` of every pixel of a BGR frame (rows x cols, `row_stride` bytes a row) into
-/// `out` (rows x cols, packed), -1 where `mask` (if not null, `mask_stride` bytes a row) is 0: the
-/// table indices of a whole row by the vectorised `hsv_row_indices`, then the look-ups (the same
-/// bins as `HsvLut::bin` pixel by pixel, several times faster). With a mask, only the masked
+/// `out` (rows x cols, packed), -1 where `mask` (if not null, `mask_stride` bytes a row) is 0: a
+/// whole row by `HsvLut::bins_of_row` (AVX2), else the table indices of the row by the
+/// vectorised `hsv_row_indices`, then the look-ups (the same bins as `HsvLut::bin` pixel by
+/// pixel, several times faster). With a mask, only the masked
 /// pixels are binned, one by one: a foreground mask leaves most pixels out, and most rows empty
 /// (skipped eight bytes at a time). `out_stride` is in elements: the bins of one rectangle of a
 /// larger image (each pixel's bin depends on that pixel only, so any rectangle gets the bins the
@@ -809,15 +904,14 @@ PFTRACK_VECTOR_CLONES static void mask_bins_row(const std::int16_t* __restrict s
 inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index rows, Index cols,
                            Index row_stride, const std::uint8_t* mask, Index mask_stride,
                            std::int16_t* out, Index out_stride) {
-    std::vector<std::int32_t> si, hi;
-    if (mask == nullptr) {
-        si.resize(static_cast<size_t>(cols));
-        hi.resize(static_cast<size_t>(cols));
-    }
+    std::vector<std::int32_t> si, hi;  // the table indices of a row, without AVX2
     for (Index y = 0; y < rows; ++y) {
         std::int16_t* o = out + y * out_stride;
         const std::uint8_t* px = bgr + y * row_stride;
         if (mask == nullptr) {
+            if (lut.bins_of_row(cols, px, o)) continue;
+            si.resize(static_cast<size_t>(cols));
+            hi.resize(static_cast<size_t>(cols));
             detail::hsv_row_indices(cols, px, si.data(), hi.data());
             for (Index x = 0; x < cols; ++x)
                 o[x] = static_cast<std::int16_t>(lut.bin_at(si[static_cast<size_t>(x)],
