@@ -72,47 +72,47 @@ struct EdgeScratch {
     std::vector<Index> rx, ry, xm, xp;    // reflected indices
 };
 
-/// `edge_magnitudes`' row pass of the 5x5 Gaussian: tmp (ph x w) from pad (ph x pw, pw = w + 4),
-/// t = g0 p0 + g1 p1 + g2 p2 + g1 p3 + g0 p4 in float32, in this order (no FMA: the AVX2 clone
-/// gives the baseline's floats).
+/// `edge_magnitudes`' row pass of the 5x5 Gaussian, over the n = ph pw floats of pad (ph rows
+/// of pw = w + 4: a channel's w pixels and 2 reflected ones on each side) as one sequence:
+/// tmp[i] = g0 p[i] + g1 p[i+1] + g2 p[i+2] + g1 p[i+3] + g0 p[i+4] in float32, in this order
+/// (no FMA: the AVX2 clone gives the baseline's floats). tmp keeps pad's row stride pw: columns
+/// 0 .. w-1 of each row are the blur, the 4 after them mix two rows and are never used. One loop
+/// instead of a loop of w per row, each with its own vector remainder (regions 20-40 px wide).
 PFTRACK_VECTOR_CLONES static void blur_rows5(const float* __restrict pad, float* __restrict tmp,
-                                             Index ph, Index w, Index pw, float g0, float g1,
-                                             float g2) {
-    for (Index yy = 0; yy < ph; ++yy) {
-        const float* __restrict p = pad + yy * pw;
-        float* __restrict t = tmp + yy * w;
-        for (Index x = 0; x < w; ++x)
-            t[x] = g0 * p[x] + g1 * p[x + 1] + g2 * p[x + 2] + g1 * p[x + 3] + g0 * p[x + 4];
-    }
+                                             Index n, float g0, float g1, float g2) {
+    for (Index i = 0; i < n - 4; ++i)
+        tmp[i] = g0 * pad[i] + g1 * pad[i + 1] + g2 * pad[i + 2] + g1 * pad[i + 3] +
+                 g0 * pad[i + 4];
+    for (Index i = std::max(n - 4, Index(0)); i < n; ++i) tmp[i] = 0.0f;  // unused, but defined
 }
 
-/// `edge_magnitudes`' column pass: blur (h x w) from tmp (h + 4 rows of w), the same taps. Rows
-/// of both are contiguous, so the pass is one loop over the h w outputs (not h loops of w, each
-/// with its own vector remainder: the regions are 20-40 pixels wide).
+/// `edge_magnitudes`' column pass: blur (h rows of stride pw) from tmp (h + 4 rows of stride
+/// pw), the same taps, as one loop over the h pw outputs (unused columns included).
 PFTRACK_VECTOR_CLONES static void blur_cols5(const float* __restrict tmp, float* __restrict blur,
-                                             Index h, Index w, float g0, float g1, float g2) {
-    const Index n = h * w;
+                                             Index h, Index pw, float g0, float g1, float g2) {
+    const Index n = h * pw;
     for (Index i = 0; i < n; ++i)
-        blur[i] = g0 * tmp[i] + g1 * tmp[i + w] + g2 * tmp[i + 2 * w] + g1 * tmp[i + 3 * w] +
-                  g0 * tmp[i + 4 * w];
+        blur[i] = g0 * tmp[i] + g1 * tmp[i + pw] + g2 * tmp[i + 2 * pw] + g1 * tmp[i + 3 * pw] +
+                  g0 * tmp[i + 4 * pw];
 }
 
 /// `edge_magnitudes`' Sobel away from the region's border: best[i] = max(0, max_c gx_c^2 +
-/// gy_c^2) for the flat indices i in [w + 1, (h - 1) w - 1) of the three h x w planes of `blur`,
-/// the same float operations in the same order as the per-pixel code (so the same values), run
-/// as one loop over the rows' concatenation: i +- 1 at columns 0 and w - 1 wraps into the next
-/// row, whose wrong values the caller never reads (it computes the border pixels itself).
-PFTRACK_VECTOR_CLONES static void sobel_best(const float* __restrict blur, Index h, Index w,
+/// gy_c^2) for the flat indices i in [pw + 1, (h - 1) pw - 1) of the three planes of `blur`
+/// (h rows of stride pw each), the same float operations in the same order as the per-pixel
+/// code (so the same values), as one loop over the rows' concatenation: at columns 0 and
+/// w - 1 .. pw - 1, i +- 1 reaches another row or an unused column, values the caller never
+/// reads (it computes the border pixels itself).
+PFTRACK_VECTOR_CLONES static void sobel_best(const float* __restrict blur, Index h, Index pw,
                                              float* __restrict best) {
-    const Index hw = h * w;
+    const Index n = h * pw;
     const float* __restrict b0 = blur;
-    const float* __restrict b1 = blur + hw;
-    const float* __restrict b2 = blur + 2 * hw;
-    for (Index i = w + 1; i < hw - w - 1; ++i) {
+    const float* __restrict b1 = blur + n;
+    const float* __restrict b2 = blur + 2 * n;
+    for (Index i = pw + 1; i < n - pw - 1; ++i) {
         float m = 0.0f;
         for (const float* __restrict b : {b0, b1, b2}) {
-            const float* r0 = b - w;
-            const float* r2 = b + w;
+            const float* r0 = b - pw;
+            const float* r2 = b + pw;
             const float gx =
                 (r0[i + 1] - r0[i - 1]) + 2.0f * (b[i + 1] - b[i - 1]) + (r2[i + 1] - r2[i - 1]);
             const float gy =
@@ -133,7 +133,8 @@ void edge_magnitudes(FillRow fill_row, Index h, Index w, const ScratchVector<std
     static const std::array<double, 5> gd = gaussian5_sigma15();
     const float g0 = static_cast<float>(gd[0]), g1 = static_cast<float>(gd[1]),
                 g2 = static_cast<float>(gd[2]);  // symmetric: g3 = g1, g4 = g0
-    const Index pw = w + 4, ph = h + 4;
+    // every plane below has rows of stride pw: the padded width
+    const Index pw = w + 4, ph = h + 4, plane = h * pw;
     s.rx.resize(static_cast<size_t>(pw));
     s.ry.resize(static_cast<size_t>(ph));
     for (Index j = 0; j < pw; ++j) s.rx[static_cast<size_t>(j)] = reflect101(j - 2, w);
@@ -145,8 +146,8 @@ void edge_magnitudes(FillRow fill_row, Index h, Index w, const ScratchVector<std
         s.xp[static_cast<size_t>(x)] = reflect101(x + 1, w);
     }
     s.pad.resize(static_cast<size_t>(pw * ph));
-    s.tmp.resize(static_cast<size_t>(w * ph));
-    s.blur.resize(static_cast<size_t>(3 * w * h));
+    s.tmp.resize(static_cast<size_t>(pw * ph));
+    s.blur.resize(static_cast<size_t>(3 * plane));
     for (int c = 0; c < 3; ++c) {
         // the channel with 2 reflected pixels on every side: each row read once, its 2 + 2
         // margin pixels copied from inside it
@@ -158,31 +159,32 @@ void edge_magnitudes(FillRow fill_row, Index h, Index w, const ScratchVector<std
         }
         // rows first, then columns (OpenCV's separable order)
         // (AVX2 or baseline clones: blur_rows5, blur_cols5)
-        blur_rows5(s.pad.data(), s.tmp.data(), ph, w, pw, g0, g1, g2);
-        blur_cols5(s.tmp.data(), s.blur.data() + c * h * w, h, w, g0, g1, g2);
+        blur_rows5(s.pad.data(), s.tmp.data(), pw * ph, g0, g1, g2);
+        blur_cols5(s.tmp.data(), s.blur.data() + c * plane, h, pw, g0, g1, g2);
     }
     // the interior in one vectorised pass (AVX2 or baseline clones: sobel_best); the border
     // pixels (reflected neighbours) per pixel below
-    s.best.resize(static_cast<size_t>(h * w));
-    sobel_best(s.blur.data(), h, w, s.best.data());
+    s.best.resize(static_cast<size_t>(plane));
+    sobel_best(s.blur.data(), h, pw, s.best.data());
     mag.clear();
     for (Index y = 0; y < h; ++y) {
         const Index ym = reflect101(y - 1, h), yp = reflect101(y + 1, h);
         const std::uint8_t* in = band.data() + y * w;
+        const float* best_row = s.best.data() + y * pw;
         const bool border_row = y == 0 || y == h - 1;
         for (Index x = 0; x < w; ++x) {
             if (!in[x]) continue;
             if (!border_row && x != 0 && x != w - 1) {
-                mag.push_back(std::sqrt(static_cast<double>(s.best[static_cast<size_t>(y * w + x)])));
+                mag.push_back(std::sqrt(static_cast<double>(best_row[x])));
                 continue;
             }
             const Index xm = s.xm[static_cast<size_t>(x)], xp = s.xp[static_cast<size_t>(x)];
             float best = 0.0f;
             for (int c = 0; c < 3; ++c) {
-                const float* b = s.blur.data() + c * h * w;
-                const float* r0 = b + ym * w;
-                const float* r1 = b + y * w;
-                const float* r2 = b + yp * w;
+                const float* b = s.blur.data() + c * plane;
+                const float* r0 = b + ym * pw;
+                const float* r1 = b + y * pw;
+                const float* r2 = b + yp * pw;
                 // Sobel: [-1 0 1] along the axis, [1 2 1] across it
                 const float gx = (r0[xp] - r0[xm]) + 2.0f * (r1[xp] - r1[xm]) + (r2[xp] - r2[xm]);
                 const float gy = (r2[xm] - r0[xm]) + 2.0f * (r2[x] - r0[x]) + (r2[xp] - r0[xp]);
