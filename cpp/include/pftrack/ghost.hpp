@@ -123,13 +123,13 @@ PFTRACK_VECTOR_CLONES static void sobel_best(const float* __restrict blur, Index
     }
 }
 
-/// The edge magnitude at each band pixel (`band`, h x w, row-major, non-zero = in), in row-major
-/// order, into `mag`: sqrt(max_c (gx_c^2 + gy_c^2)), gx, gy the 3x3 Sobel derivatives of the 5x5
-/// Gaussian blur (float32, as OpenCV's) of channel c of the h x w image whose row y of channel c
-/// `fill_row(y, c, out)` writes to out[0 .. w).
+/// The squared edge magnitude at each band pixel (`band`, h x w, row-major, non-zero = in) into
+/// `s.best` (h rows of stride w + 4; other pixels undefined): max_c (gx_c^2 + gy_c^2), gx, gy
+/// the 3x3 Sobel derivatives of the 5x5 Gaussian blur (float32, as OpenCV's) of channel c of the
+/// h x w image whose row y of channel c `fill_row(y, c, out)` writes to out[0 .. w).
 template <class FillRow>
 void edge_magnitudes(FillRow fill_row, Index h, Index w, const ScratchVector<std::uint8_t>& band,
-                     EdgeScratch& s, std::vector<double>& mag) {
+                     EdgeScratch& s) {
     static const std::array<double, 5> gd = gaussian5_sigma15();
     const float g0 = static_cast<float>(gd[0]), g1 = static_cast<float>(gd[1]),
                 g2 = static_cast<float>(gd[2]);  // symmetric: g3 = g1, g4 = g0
@@ -166,18 +166,14 @@ void edge_magnitudes(FillRow fill_row, Index h, Index w, const ScratchVector<std
     // pixels (reflected neighbours) per pixel below
     s.best.resize(static_cast<size_t>(plane));
     sobel_best(s.blur.data(), h, pw, s.best.data());
-    mag.clear();
+    // the border pixels of the band: reflected neighbours, per pixel
     for (Index y = 0; y < h; ++y) {
         const Index ym = reflect101(y - 1, h), yp = reflect101(y + 1, h);
         const std::uint8_t* in = band.data() + y * w;
-        const float* best_row = s.best.data() + y * pw;
         const bool border_row = y == 0 || y == h - 1;
-        for (Index x = 0; x < w; ++x) {
+        const Index step = border_row ? 1 : w - 1;  // every column, or the first and last
+        for (Index x = 0; x < w; x += step) {
             if (!in[x]) continue;
-            if (!border_row && x != 0 && x != w - 1) {
-                mag.push_back(std::sqrt(static_cast<double>(best_row[x])));
-                continue;
-            }
             const Index xm = s.xm[static_cast<size_t>(x)], xp = s.xp[static_cast<size_t>(x)];
             float best = 0.0f;
             for (int c = 0; c < 3; ++c) {
@@ -190,7 +186,7 @@ void edge_magnitudes(FillRow fill_row, Index h, Index w, const ScratchVector<std
                 const float gy = (r2[xm] - r0[xm]) + 2.0f * (r2[x] - r0[x]) + (r2[xp] - r0[xp]);
                 best = std::max(best, gx * gx + gy * gy);
             }
-            mag.push_back(std::sqrt(static_cast<double>(best)));
+            s.best[static_cast<size_t>(y * pw + x)] = best;
         }
     }
 }
@@ -272,7 +268,7 @@ inline void edge_support(const std::uint8_t* bgr, Index row_stride, const float*
                          const double* boxes, Index k, double* out,
                          GhostStatistic statistic = GhostStatistic::ratio) {
     detail::EdgeScratch scratch;
-    std::vector<double> mag_f, mag_b;
+    detail::ScratchVector<float> best_f;  // the frame's squared magnitudes (scratch.best's)
     detail::ScratchVector<std::uint8_t> on, band, hmax, hmin;  // written in full by band_rows
     for (Index i = 0; i < k; ++i) {
         out[i] = 0.5;
@@ -298,7 +294,8 @@ inline void edge_support(const std::uint8_t* bgr, Index row_stride, const float*
                 // (AVX2 or baseline clones: detail::channel_floats)
                 detail::channel_floats(bgr + (y0 + y) * row_stride + 3 * x0 + c, out, w);
             },
-            h, w, band, scratch, mag_f);
+            h, w, band, scratch);
+        std::swap(best_f, scratch.best);  // O(1): the background's go into the other buffer
         detail::edge_magnitudes(
             [&](Index y, int c, float* __restrict out) {
                 const float* __restrict p = background + (y0 + y) * bg_row_stride +
@@ -308,16 +305,30 @@ inline void edge_support(const std::uint8_t* bgr, Index row_stride, const float*
                 else
                     for (Index x = 0; x < w; ++x) out[x] = p[x * bg_pixel_stride];
             },
-            h, w, band, scratch, mag_b);
+            h, w, band, scratch);
+        // one pass over the band for both pictures, in row-major order (planes of stride w + 4)
+        const float* bf = best_f.data();
+        const float* bb = scratch.best.data();
+        const Index pw = w + 4;
         if (statistic == GhostStatistic::vote) {
-            Index stronger = 0;
-            for (size_t j = 0; j < mag_f.size(); ++j) stronger += mag_f[j] > mag_b[j] ? 1 : 0;
-            out[i] = static_cast<double>(stronger) / static_cast<double>(mag_f.size());
+            // sqrt is increasing: comparing the squares gives the magnitudes' comparison
+            Index stronger = 0, count = 0;
+            for (Index y = 0; y < h; ++y)
+                for (Index x = 0; x < w; ++x)
+                    if (band[static_cast<size_t>(y * w + x)]) {
+                        stronger += bf[y * pw + x] > bb[y * pw + x] ? 1 : 0;
+                        ++count;
+                    }
+            out[i] = static_cast<double>(stronger) / static_cast<double>(count);
             continue;
         }
-        double e_f = 0.0, e_b = 0.0;  // summed in the band's row-major order
-        for (const double v : mag_f) e_f += v;
-        for (const double v : mag_b) e_b += v;
+        double e_f = 0.0, e_b = 0.0;  // each summed in the band's row-major order
+        for (Index y = 0; y < h; ++y)
+            for (Index x = 0; x < w; ++x)
+                if (band[static_cast<size_t>(y * w + x)]) {
+                    e_f += std::sqrt(static_cast<double>(bf[y * pw + x]));
+                    e_b += std::sqrt(static_cast<double>(bb[y * pw + x]));
+                }
         if (e_f + e_b > 0.0) out[i] = e_f / (e_f + e_b);
     }
 }
