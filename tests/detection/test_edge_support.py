@@ -188,3 +188,30 @@ def test_edge_support_at_every_region_size(statistic: str) -> None:
         np.testing.assert_allclose(got, want, rtol=0, atol=0.05)
         assert np.mean(got == want) > 0.9
     assert not np.any(got == 0.5)  # every region has a band
+
+
+def test_edge_support_of_every_small_region_shape() -> None:
+    """Every region from 3 x 3 to 11 x 11 px, the band on its border rows and columns and inside:
+    the blur and Sobel run as flat loops over rows of the padded width, whose values at the
+    columns past each row's end and whose wrapped neighbours at its first and last column must
+    never reach a magnitude (the border pixels are computed apart); held to the reference."""
+    rng = np.random.default_rng(33)
+    rows, cols = 60, 80
+    frame = (rng.integers(0, 256, (rows, cols, 3), dtype=np.uint8) // 32 * 32).astype(np.uint8)
+    background = rng.uniform(0, 255, (rows, cols, 3)).astype(np.float32)
+    mask = np.where(rng.random((rows, cols)) < 0.6, 255, 0).astype(np.uint8)
+    shapes = [(h, w) for h in range(3, 12) for w in range(3, 12)]
+    corners = rng.integers(0, [rows - 11, cols - 11], (len(shapes), 2))
+    # region [x, x + w) x [y, y + h): int(left) - 4 = x and int(left + width) + 4 = x + w
+    boxes = np.array(
+        [[x + 4, y + 4, w - 8, h - 8] for (h, w), (y, x) in zip(shapes, corners, strict=True)],
+        np.float64,
+    )
+    model = model_with(background)
+    got = model.edge_support(frame, mask, boxes)
+    want = edge_support_reference(frame, background, mask, boxes)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-5)
+    assert np.all(got != 0.5)  # every region has a band
+    vote = model.edge_support(frame, mask, boxes, "vote")
+    want_vote = edge_support_reference(frame, background, mask, boxes, "vote")
+    assert np.mean(vote == want_vote) > 0.9  # a float32 near tie may flip one pixel's vote

@@ -11,6 +11,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <new>
+#include <utility>
 #include <vector>
 
 #include "types.hpp"
@@ -39,49 +41,100 @@ inline std::array<double, 5> gaussian5_sigma15() {
     return g;
 }
 
-/// Scratch of `edge_sum`, reused from blob to blob.
+/// std::allocator whose `resize` leaves new elements uninitialised: the scratch below is
+/// written in full before it is read, and value-initialising it on every growth was 7 % of
+/// `edge_support`'s instructions (memset).
+template <class T>
+struct UninitAllocator : std::allocator<T> {
+    template <class U>
+    struct rebind {
+        using other = UninitAllocator<U>;
+    };
+    UninitAllocator() = default;
+    template <class U>
+    UninitAllocator(const UninitAllocator<U>&) noexcept {}
+    template <class U>
+    void construct(U* p) noexcept {
+        ::new (static_cast<void*>(p)) U;  // default-, not value-initialised
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+template <class T>
+using ScratchVector = std::vector<T, UninitAllocator<T>>;
+
+/// Scratch of `edge_magnitudes`, reused from blob to blob.
 struct EdgeScratch {
-    std::vector<float> pad, tmp, blur;       // padded channel, row-filtered, blurred (3 planes)
-    std::vector<Index> rx, ry, xm, xp;      // reflected indices
+    ScratchVector<float> pad, tmp, blur;  // padded channel, row-filtered, blurred (3 planes)
+    ScratchVector<float> best;            // largest squared magnitude over the channels
+    std::vector<Index> rx, ry, xm, xp;    // reflected indices
 };
 
-/// `edge_magnitudes`' row pass of the 5x5 Gaussian: tmp (ph x w) from pad (ph x pw, pw = w + 4),
-/// t = g0 p0 + g1 p1 + g2 p2 + g1 p3 + g0 p4 in float32, in this order (no FMA: the AVX2 clone
-/// gives the baseline's floats).
+/// `edge_magnitudes`' row pass of the 5x5 Gaussian, over the n = ph pw floats of pad (ph rows
+/// of pw = w + 4: a channel's w pixels and 2 reflected ones on each side) as one sequence:
+/// tmp[i] = g0 p[i] + g1 p[i+1] + g2 p[i+2] + g1 p[i+3] + g0 p[i+4] in float32, in this order
+/// (no FMA: the AVX2 clone gives the baseline's floats). tmp keeps pad's row stride pw: columns
+/// 0 .. w-1 of each row are the blur, the 4 after them mix two rows and are never used. One loop
+/// instead of a loop of w per row, each with its own vector remainder (regions 20-40 px wide).
 PFTRACK_VECTOR_CLONES static void blur_rows5(const float* __restrict pad, float* __restrict tmp,
-                                             Index ph, Index w, Index pw, float g0, float g1,
-                                             float g2) {
-    for (Index yy = 0; yy < ph; ++yy) {
-        const float* __restrict p = pad + yy * pw;
-        float* __restrict t = tmp + yy * w;
-        for (Index x = 0; x < w; ++x)
-            t[x] = g0 * p[x] + g1 * p[x + 1] + g2 * p[x + 2] + g1 * p[x + 3] + g0 * p[x + 4];
-    }
+                                             Index n, float g0, float g1, float g2) {
+    for (Index i = 0; i < n - 4; ++i)
+        tmp[i] = g0 * pad[i] + g1 * pad[i + 1] + g2 * pad[i + 2] + g1 * pad[i + 3] +
+                 g0 * pad[i + 4];
+    for (Index i = std::max(n - 4, Index(0)); i < n; ++i) tmp[i] = 0.0f;  // unused, but defined
 }
 
-/// `edge_magnitudes`' column pass: blur (h x w) from tmp (h + 4 rows of w), the same taps.
+/// `edge_magnitudes`' column pass: blur (h rows of stride pw) from tmp (h + 4 rows of stride
+/// pw), the same taps, as one loop over the h pw outputs (unused columns included).
 PFTRACK_VECTOR_CLONES static void blur_cols5(const float* __restrict tmp, float* __restrict blur,
-                                             Index h, Index w, float g0, float g1, float g2) {
-    for (Index y = 0; y < h; ++y) {
-        const float* __restrict t0 = tmp + y * w;
-        float* __restrict b = blur + y * w;
-        for (Index x = 0; x < w; ++x)
-            b[x] = g0 * t0[x] + g1 * t0[x + w] + g2 * t0[x + 2 * w] + g1 * t0[x + 3 * w] +
-                   g0 * t0[x + 4 * w];
+                                             Index h, Index pw, float g0, float g1, float g2) {
+    const Index n = h * pw;
+    for (Index i = 0; i < n; ++i)
+        blur[i] = g0 * tmp[i] + g1 * tmp[i + pw] + g2 * tmp[i + 2 * pw] + g1 * tmp[i + 3 * pw] +
+                  g0 * tmp[i + 4 * pw];
+}
+
+/// `edge_magnitudes`' Sobel away from the region's border: best[i] = max(0, max_c gx_c^2 +
+/// gy_c^2) for the flat indices i in [pw + 1, (h - 1) pw - 1) of the three planes of `blur`
+/// (h rows of stride pw each), the same float operations in the same order as the per-pixel
+/// code (so the same values), as one loop over the rows' concatenation: at columns 0 and
+/// w - 1 .. pw - 1, i +- 1 reaches another row or an unused column, values the caller never
+/// reads (it computes the border pixels itself).
+PFTRACK_VECTOR_CLONES static void sobel_best(const float* __restrict blur, Index h, Index pw,
+                                             float* __restrict best) {
+    const Index n = h * pw;
+    const float* __restrict b0 = blur;
+    const float* __restrict b1 = blur + n;
+    const float* __restrict b2 = blur + 2 * n;
+    for (Index i = pw + 1; i < n - pw - 1; ++i) {
+        float m = 0.0f;
+        for (const float* __restrict b : {b0, b1, b2}) {
+            const float* r0 = b - pw;
+            const float* r2 = b + pw;
+            const float gx =
+                (r0[i + 1] - r0[i - 1]) + 2.0f * (b[i + 1] - b[i - 1]) + (r2[i + 1] - r2[i - 1]);
+            const float gy =
+                (r2[i - 1] - r0[i - 1]) + 2.0f * (r2[i] - r0[i]) + (r2[i + 1] - r0[i + 1]);
+            m = std::max(m, gx * gx + gy * gy);
+        }
+        best[i] = m;
     }
 }
 
-/// The edge magnitude at each band pixel (`band`, h x w, row-major, non-zero = in), in row-major
-/// order, into `mag`: sqrt(max_c (gx_c^2 + gy_c^2)), gx, gy the 3x3 Sobel derivatives of the 5x5
-/// Gaussian blur (float32, as OpenCV's) of channel c of the h x w image whose row y of channel c
-/// `fill_row(y, c, out)` writes to out[0 .. w).
+/// The squared edge magnitude at each band pixel (`band`, h x w, row-major, non-zero = in) into
+/// `s.best` (h rows of stride w + 4; other pixels undefined): max_c (gx_c^2 + gy_c^2), gx, gy
+/// the 3x3 Sobel derivatives of the 5x5 Gaussian blur (float32, as OpenCV's) of channel c of the
+/// h x w image whose row y of channel c `fill_row(y, c, out)` writes to out[0 .. w).
 template <class FillRow>
-void edge_magnitudes(FillRow fill_row, Index h, Index w, const std::vector<std::uint8_t>& band,
-                     EdgeScratch& s, std::vector<double>& mag) {
+void edge_magnitudes(FillRow fill_row, Index h, Index w, const ScratchVector<std::uint8_t>& band,
+                     EdgeScratch& s) {
     static const std::array<double, 5> gd = gaussian5_sigma15();
     const float g0 = static_cast<float>(gd[0]), g1 = static_cast<float>(gd[1]),
                 g2 = static_cast<float>(gd[2]);  // symmetric: g3 = g1, g4 = g0
-    const Index pw = w + 4, ph = h + 4;
+    // every plane below has rows of stride pw: the padded width
+    const Index pw = w + 4, ph = h + 4, plane = h * pw;
     s.rx.resize(static_cast<size_t>(pw));
     s.ry.resize(static_cast<size_t>(ph));
     for (Index j = 0; j < pw; ++j) s.rx[static_cast<size_t>(j)] = reflect101(j - 2, w);
@@ -93,8 +146,8 @@ void edge_magnitudes(FillRow fill_row, Index h, Index w, const std::vector<std::
         s.xp[static_cast<size_t>(x)] = reflect101(x + 1, w);
     }
     s.pad.resize(static_cast<size_t>(pw * ph));
-    s.tmp.resize(static_cast<size_t>(w * ph));
-    s.blur.resize(static_cast<size_t>(3 * w * h));
+    s.tmp.resize(static_cast<size_t>(pw * ph));
+    s.blur.resize(static_cast<size_t>(3 * plane));
     for (int c = 0; c < 3; ++c) {
         // the channel with 2 reflected pixels on every side: each row read once, its 2 + 2
         // margin pixels copied from inside it
@@ -106,28 +159,34 @@ void edge_magnitudes(FillRow fill_row, Index h, Index w, const std::vector<std::
         }
         // rows first, then columns (OpenCV's separable order)
         // (AVX2 or baseline clones: blur_rows5, blur_cols5)
-        blur_rows5(s.pad.data(), s.tmp.data(), ph, w, pw, g0, g1, g2);
-        blur_cols5(s.tmp.data(), s.blur.data() + c * h * w, h, w, g0, g1, g2);
+        blur_rows5(s.pad.data(), s.tmp.data(), pw * ph, g0, g1, g2);
+        blur_cols5(s.tmp.data(), s.blur.data() + c * plane, h, pw, g0, g1, g2);
     }
-    mag.clear();
+    // the interior in one vectorised pass (AVX2 or baseline clones: sobel_best); the border
+    // pixels (reflected neighbours) per pixel below
+    s.best.resize(static_cast<size_t>(plane));
+    sobel_best(s.blur.data(), h, pw, s.best.data());
+    // the border pixels of the band: reflected neighbours, per pixel
     for (Index y = 0; y < h; ++y) {
         const Index ym = reflect101(y - 1, h), yp = reflect101(y + 1, h);
         const std::uint8_t* in = band.data() + y * w;
-        for (Index x = 0; x < w; ++x) {
+        const bool border_row = y == 0 || y == h - 1;
+        const Index step = border_row ? 1 : w - 1;  // every column, or the first and last
+        for (Index x = 0; x < w; x += step) {
             if (!in[x]) continue;
             const Index xm = s.xm[static_cast<size_t>(x)], xp = s.xp[static_cast<size_t>(x)];
             float best = 0.0f;
             for (int c = 0; c < 3; ++c) {
-                const float* b = s.blur.data() + c * h * w;
-                const float* r0 = b + ym * w;
-                const float* r1 = b + y * w;
-                const float* r2 = b + yp * w;
+                const float* b = s.blur.data() + c * plane;
+                const float* r0 = b + ym * pw;
+                const float* r1 = b + y * pw;
+                const float* r2 = b + yp * pw;
                 // Sobel: [-1 0 1] along the axis, [1 2 1] across it
                 const float gx = (r0[xp] - r0[xm]) + 2.0f * (r1[xp] - r1[xm]) + (r2[xp] - r2[xm]);
                 const float gy = (r2[xm] - r0[xm]) + 2.0f * (r2[x] - r0[x]) + (r2[xp] - r0[xp]);
                 best = std::max(best, gx * gx + gy * gy);
             }
-            mag.push_back(std::sqrt(static_cast<double>(best)));
+            s.best[static_cast<size_t>(y * pw + x)] = best;
         }
     }
 }
@@ -209,8 +268,8 @@ inline void edge_support(const std::uint8_t* bgr, Index row_stride, const float*
                          const double* boxes, Index k, double* out,
                          GhostStatistic statistic = GhostStatistic::ratio) {
     detail::EdgeScratch scratch;
-    std::vector<double> mag_f, mag_b;
-    std::vector<std::uint8_t> on, band, hmax, hmin;
+    detail::ScratchVector<float> best_f;  // the frame's squared magnitudes (scratch.best's)
+    detail::ScratchVector<std::uint8_t> on, band, hmax, hmin;  // written in full by band_rows
     for (Index i = 0; i < k; ++i) {
         out[i] = 0.5;
         const double* b = boxes + 4 * i;
@@ -235,7 +294,8 @@ inline void edge_support(const std::uint8_t* bgr, Index row_stride, const float*
                 // (AVX2 or baseline clones: detail::channel_floats)
                 detail::channel_floats(bgr + (y0 + y) * row_stride + 3 * x0 + c, out, w);
             },
-            h, w, band, scratch, mag_f);
+            h, w, band, scratch);
+        std::swap(best_f, scratch.best);  // O(1): the background's go into the other buffer
         detail::edge_magnitudes(
             [&](Index y, int c, float* __restrict out) {
                 const float* __restrict p = background + (y0 + y) * bg_row_stride +
@@ -245,16 +305,30 @@ inline void edge_support(const std::uint8_t* bgr, Index row_stride, const float*
                 else
                     for (Index x = 0; x < w; ++x) out[x] = p[x * bg_pixel_stride];
             },
-            h, w, band, scratch, mag_b);
+            h, w, band, scratch);
+        // one pass over the band for both pictures, in row-major order (planes of stride w + 4)
+        const float* bf = best_f.data();
+        const float* bb = scratch.best.data();
+        const Index pw = w + 4;
         if (statistic == GhostStatistic::vote) {
-            Index stronger = 0;
-            for (size_t j = 0; j < mag_f.size(); ++j) stronger += mag_f[j] > mag_b[j] ? 1 : 0;
-            out[i] = static_cast<double>(stronger) / static_cast<double>(mag_f.size());
+            // sqrt is increasing: comparing the squares gives the magnitudes' comparison
+            Index stronger = 0, count = 0;
+            for (Index y = 0; y < h; ++y)
+                for (Index x = 0; x < w; ++x)
+                    if (band[static_cast<size_t>(y * w + x)]) {
+                        stronger += bf[y * pw + x] > bb[y * pw + x] ? 1 : 0;
+                        ++count;
+                    }
+            out[i] = static_cast<double>(stronger) / static_cast<double>(count);
             continue;
         }
-        double e_f = 0.0, e_b = 0.0;  // summed in the band's row-major order
-        for (const double v : mag_f) e_f += v;
-        for (const double v : mag_b) e_b += v;
+        double e_f = 0.0, e_b = 0.0;  // each summed in the band's row-major order
+        for (Index y = 0; y < h; ++y)
+            for (Index x = 0; x < w; ++x)
+                if (band[static_cast<size_t>(y * w + x)]) {
+                    e_f += std::sqrt(static_cast<double>(bf[y * pw + x]));
+                    e_b += std::sqrt(static_cast<double>(bb[y * pw + x]));
+                }
         if (e_f + e_b > 0.0) out[i] = e_f / (e_f + e_b);
     }
 }
