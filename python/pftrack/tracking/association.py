@@ -210,10 +210,11 @@ def first_of_twins(boxes: F64, labels: NDArray[np.int64], candidates: Sequence[i
     detections in :func:`~pftrack.tracking.tracker.canonical_order`), are taken in the order
     given, highest score first; each that passes is kept and then explains its object. A
     candidate is refused when it overlaps, by an IoU above `overlap`
-    (``LifecycleConfig.birth_overlap``; None: every candidate is kept), a detection of its
-    class that `explained` marks (e.g. one matched to a track) or a candidate kept before it:
-    the same box twice, from a detector without non-maximum suppression or from two
-    detectors' outputs concatenated. `explained` is not changed.
+    (``LifecycleConfig.birth_overlap``, in (0, 1]: only boxes that meet are compared; None:
+    every candidate is kept), a detection of its class that `explained` marks (e.g. one
+    matched to a track) or a candidate kept before it: the same box twice, from a detector
+    without non-maximum suppression or from two detectors' outputs concatenated. `explained`
+    is not changed.
     """
     if overlap is None or len(boxes) < 2 or not len(candidates):
         return list(candidates)
