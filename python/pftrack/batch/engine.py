@@ -51,6 +51,7 @@ from pftrack.io.atomic import (
     check_output_folder,
     interrupts_deferred,
     link_loop,
+    replaceable,
     staged_outputs,
 )
 from pftrack.io.mot import write_mot
@@ -2035,6 +2036,8 @@ def _check_outputs(
             f"{out_name} {summary} exists and is not a batch's summary; this run would replace "
             f"it: move it, write elsewhere, or give {force_name}"
         )
+    from pftrack.io.video_writer import is_render  # here: it imports PyAV
+
     for job in jobs:
         ours = None  # read once a file of this job is found
         for name in (f"{job.name}{s}" for s in (".txt", ".json", *suffixes)):
@@ -2055,30 +2058,18 @@ def _check_outputs(
                     f"{out_name} {out_dir / name} exists and no earlier batch wrote it ({why}); "
                     f"this run would replace it: move it, write elsewhere, or give {force_name}"
                 )
-            if any(name.endswith(s) for s in suffixes) and not _a_render(out_dir / name):
+            if any(name.endswith(s) for s in suffixes) and not replaceable(
+                out_dir / name, is_render
+            ):
                 # named by a sidecar, but a video pftrack did not write put there since (was:
-                # replaced without a word, where --render and pftrack render refuse it)
+                # replaced without a word, where --render and pftrack render refuse it; the
+                # rule of --render's check_replaceable, with the batch's message)
                 raise ValueError(
                     f"{render_name}'s output {out_dir / name} is a video pftrack did not write "
                     "(a video of yours, put where an earlier batch's was?); this run would "
                     f"replace it: move it, write elsewhere, or give {force_name}"
                 )
     return out_dir
-
-
-def _a_render(path: Path) -> bool:
-    """Whether the video `path` may be replaced as a render: empty, or marked as pftrack's.
-
-    The rule of ``--render`` and ``pftrack render --out``
-    (:func:`pftrack.io.video_writer.is_render`).
-    """
-    from pftrack.io.video_writer import is_render
-
-    try:
-        empty = path.stat().st_size == 0
-    except OSError:
-        return True  # gone meanwhile: nothing to replace
-    return empty or not path.is_file() or is_render(path)
 
 
 def _file_id(path: Path) -> tuple[int, int] | None:

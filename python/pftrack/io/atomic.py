@@ -898,22 +898,28 @@ def check_replaceable(
     ValueError
         Such a file, naming `what` (was: a user's file replaced, exit status 0).
     """
-    if force:
+    if force or replaceable(path, ours):
         return
-    text = os.fsdecode(os.fspath(path))
-    written = _resolve(text)
-    if written.through:
-        return
+    raise ValueError(
+        f"{what} {os.fsdecode(os.fspath(path))} is an existing file that {yours}, "
+        "and would be replaced: move it, give another name, or pass --force"
+    )
+
+
+def replaceable(path: PathLike, ours: Callable[[Path], bool]) -> bool:
+    """Whether an output may replace what is at `path` without ``--force``.
+
+    :func:`check_replaceable`'s rule, for a caller with its own message (``pftrack batch``'s
+    renders): an absent path, an empty file, a device or pipe, one that cannot be read (the
+    write says so), or a file `ours` accepts.
+    """
     try:
-        if not written.path.is_file() or written.path.stat().st_size == 0:
-            return  # nothing there to lose
+        written = _resolve(os.fsdecode(os.fspath(path)))
+        if written.through or not written.path.is_file() or written.path.stat().st_size == 0:
+            return True  # nothing there to lose
     except OSError:  # unreadable: the write says so
-        return
-    if not ours(written.path):
-        raise ValueError(
-            f"{what} {text} is an existing file that {yours}, "
-            "and would be replaced: move it, give another name, or pass --force"
-        )
+        return True
+    return ours(written.path)
 
 
 def _refuse_binary(written: Path, what: str, text: str) -> None:
