@@ -24,9 +24,12 @@ namespace pftrack {
 namespace detail {
 
 /// One shortest augmenting path from free row `i`; returns the sink column, or -1 when no
-/// column can be reached at finite cost. `cost` is row-major nr x nc with nr <= nc.
-inline Eigen::Index augmenting_path(Eigen::Index nc, const std::vector<double>& cost,
-                                    std::vector<double>& u, std::vector<double>& v,
+/// column can be reached at finite cost. `row_of(i)` gives row i of the nr x nc cost matrix
+/// (nr <= nc) as a pointer to its nc entries, valid until the next call: a dense matrix's row,
+/// or a row made when the search reads it (padded_assignment, overlap.hpp).
+template <class RowOf>
+inline Eigen::Index augmenting_path(Eigen::Index nc, RowOf&& row_of, const std::vector<double>& u,
+                                    const std::vector<double>& v,
                                     std::vector<Eigen::Index>& path,
                                     const std::vector<Eigen::Index>& row4col,
                                     std::vector<double>& shortest, Eigen::Index i,
@@ -45,9 +48,10 @@ inline Eigen::Index augmenting_path(Eigen::Index nc, const std::vector<double>& 
         Eigen::Index index = -1;
         double lowest = inf;
         SR[i] = 1;
+        const double* row = row_of(i);
         for (Eigen::Index it = 0; it < num_remaining; ++it) {
             const Eigen::Index j = remaining[it];
-            const double r = min_val + cost[i * nc + j] - u[i] - v[j];
+            const double r = min_val + row[j] - u[i] - v[j];
             if (r < shortest[j]) {
                 path[j] = i;
                 shortest[j] = r;
@@ -69,6 +73,33 @@ inline Eigen::Index augmenting_path(Eigen::Index nc, const std::vector<double>& 
         remaining[index] = remaining[--num_remaining];
     }
     return sink;
+}
+
+/// After the search from free row `cur` reached column `sink` at `min_val`: Crouse's dual
+/// update of u (the rows in the tree) and v (the columns in it), then the augmentation along
+/// `path` (row4col and col4row swapped back to `cur`). With `vmax`, *vmax is raised to every
+/// v it changes (padded_assignment's bound on the entries it skips).
+inline void augment(Eigen::Index cur, Eigen::Index sink, double min_val, std::vector<double>& u,
+                    std::vector<double>& v, const std::vector<double>& shortest,
+                    const std::vector<Eigen::Index>& path, const std::vector<char>& SR,
+                    const std::vector<char>& SC, std::vector<Eigen::Index>& row4col,
+                    std::vector<Eigen::Index>& col4row, double* vmax = nullptr) {
+    const auto nr = static_cast<Eigen::Index>(SR.size()), nc = static_cast<Eigen::Index>(SC.size());
+    u[cur] += min_val;
+    for (Eigen::Index i = 0; i < nr; ++i)
+        if (SR[i] && i != cur) u[i] += min_val - shortest[col4row[i]];
+    for (Eigen::Index j = 0; j < nc; ++j)
+        if (SC[j]) {
+            v[j] -= min_val - shortest[j];
+            if (vmax != nullptr) *vmax = std::max(*vmax, v[j]);
+        }
+    Eigen::Index j = sink;
+    while (true) {
+        const Eigen::Index i = path[j];
+        row4col[j] = i;
+        std::swap(col4row[i], j);
+        if (i == cur) break;
+    }
 }
 
 }  // namespace detail
@@ -99,21 +130,11 @@ inline std::pair<Eigen::VectorXi, Eigen::VectorXi> linear_sum_assignment(
     std::vector<char> SR(nr), SC(nc);
     for (Eigen::Index cur = 0; cur < nr; ++cur) {
         double min_val = 0.0;
-        const Eigen::Index sink = detail::augmenting_path(nc, c, u, v, path, row4col, shortest,
-                                                          cur, SR, SC, remaining, min_val);
+        const Eigen::Index sink = detail::augmenting_path(
+            nc, [&](Eigen::Index i) { return c.data() + i * nc; }, u, v, path, row4col,
+            shortest, cur, SR, SC, remaining, min_val);
         require(sink >= 0, fn, "cost matrix is infeasible (no assignment at finite cost)");
-        u[cur] += min_val;
-        for (Eigen::Index i = 0; i < nr; ++i)
-            if (SR[i] && i != cur) u[i] += min_val - shortest[col4row[i]];
-        for (Eigen::Index j = 0; j < nc; ++j)
-            if (SC[j]) v[j] -= min_val - shortest[j];
-        Eigen::Index j = sink;
-        while (true) {
-            const Eigen::Index i = path[j];
-            row4col[j] = i;
-            std::swap(col4row[i], j);
-            if (i == cur) break;
-        }
+        detail::augment(cur, sink, min_val, u, v, shortest, path, SR, SC, row4col, col4row);
     }
     if (transpose) {
         // rows ascending in the caller's orientation: order the pairs by the column they got

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "pftrack/assignment.hpp"
 #include "pftrack/check.hpp"
 #include "pftrack/types.hpp"
 
@@ -127,8 +128,8 @@ inline std::pair<Eigen::VectorXi, Eigen::VectorXi> padded_assignment(
             row = pad_row.data();
         }
     };
-    // from here: linear_sum_assignment and detail::augmenting_path with cost[i * nc + j] read
-    // as row[j] after fill(i)
+    // from here: linear_sum_assignment's state and steps (assignment.hpp), a row of the padded
+    // matrix read as row[j] after fill(i)
     const Index nc = n;
     std::vector<double> u(n, 0.0), v(nc, 0.0), shortest(nc);
     std::vector<Index> path(nc, -1), col4row(n, -1), row4col(nc, -1), remaining(nc);
@@ -173,35 +174,11 @@ inline std::pair<Eigen::VectorXi, Eigen::VectorXi> padded_assignment(
         sink = -1;
     };
     auto full_search = [&](Index cur) {
-        Index i = cur, num_remaining = 0;
-        start(num_remaining);
-        while (sink == -1) {
-            Index index = -1;
-            double lowest = inf;
-            SR[i] = 1;
-            fill(i);
-            for (Index it = 0; it < num_remaining; ++it) {
-                const Index j = remaining[it];
-                const double r = min_val + row[j] - u[i] - v[j];
-                if (r < shortest[j]) {
-                    path[j] = i;
-                    shortest[j] = r;
-                }
-                if (shortest[j] < lowest || (shortest[j] == lowest && row4col[j] == -1)) {
-                    lowest = shortest[j];
-                    index = it;
-                }
-            }
-            min_val = lowest;
-            require(min_val != inf, fn, "cost matrix is infeasible (no assignment at finite cost)");
-            const Index j = remaining[index];
-            if (row4col[j] == -1)
-                sink = j;
-            else
-                i = row4col[j];
-            SC[j] = 1;
-            remaining[index] = remaining[--num_remaining];
-        }
+        // assignment.hpp's search itself, each row made as it reads it
+        sink = detail::augmenting_path(
+            nc, [&](Index i) { fill(i); return row; }, u, v, path, row4col, shortest, cur, SR,
+            SC, remaining, min_val);
+        require(sink >= 0, fn, "cost matrix is infeasible (no assignment at finite cost)");
     };
     auto sparse_search = [&](Index cur) -> bool {
         Index i = cur, num_remaining = 0;
@@ -270,21 +247,8 @@ inline std::pair<Eigen::VectorXi, Eigen::VectorXi> padded_assignment(
     };
     for (Index cur = 0; cur < n; ++cur) {
         if (!sparse_search(cur)) full_search(cur);
-        u[cur] += min_val;
-        for (Index r = 0; r < n; ++r)
-            if (SR[r] && r != cur) u[r] += min_val - shortest[col4row[r]];
-        for (Index j = 0; j < nc; ++j)
-            if (SC[j]) {
-                v[j] -= min_val - shortest[j];
-                vmax = std::max(vmax, v[j]);
-            }
-        Index j = sink;
-        while (true) {
-            const Index r = path[j];
-            row4col[j] = r;
-            std::swap(col4row[r], j);
-            if (r == cur) break;
-        }
+        detail::augment(cur, sink, min_val, u, v, shortest, path, SR, SC, row4col, col4row,
+                        &vmax);
     }
     for (Index k = 0; k < n; ++k) {
         rows[k] = static_cast<int>(k);
