@@ -91,53 +91,6 @@ py::array_t<std::uint8_t> mask_pass(const py::object& mask_in, const py::object&
     return out;
 }
 
-
-/// clean_regions (morphology.hpp) of a (H, W) uint8/bool mask, checked: (new mask, partial).
-py::tuple clean_mask(const py::object& mask_in, const py::object& open_in,
-                     const py::object& close_in, const py::object& regions_in) {
-    const char* fn = "clean_mask";
-    const py::array mask = bind::mask_array(mask_in, fn);
-    if (!(mask.ndim() == 2 && mask.shape(0) > 0 && mask.shape(1) > 0))
-        fail(fn, "mask must be a non-empty (H, W) array");
-    bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);
-    const std::vector<ElementRow> open_el =
-        to_element(bind::mask_array(open_in, fn, "open_element", "(kh, kw)"), fn);
-    const std::vector<ElementRow> close_el =
-        to_element(bind::mask_array(close_in, fn, "close_element", "(kh, kw)"), fn);
-    const Index rows = mask.shape(0), cols = mask.shape(1);
-    std::vector<PixelRect> regions;
-    const bool whole = regions_in.is_none();
-    if (!whole) {
-        const auto r = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(
-            regions_in);
-        if (!r || !(r.ndim() == 2 && r.shape(1) == 4))
-            fail(fn, "regions must be a (K, 4) integer array x0, y0, x1, y1, or None");
-        for (py::ssize_t k = 0; k < r.shape(0); ++k)
-            regions.push_back({static_cast<Index>(r.at(k, 0)), static_cast<Index>(r.at(k, 1)),
-                               static_cast<Index>(r.at(k, 2)), static_cast<Index>(r.at(k, 3))});
-    }
-    auto out = new_mask(rows, cols);
-    std::uint8_t* optr = out.mutable_data();
-    const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
-    const Index mstride = mask.strides(0);
-    bool partial = false;
-    {
-        py::gil_scoped_release nogil;  // safe: raw buffers held by the caller / owned here
-        thread_local std::vector<std::uint8_t> a, b;  // per thread, as mask_pass's
-        thread_local MorphScratch scratch;
-        if (whole) {
-            a.resize(static_cast<size_t>(rows * cols));
-            b.resize(static_cast<size_t>(rows * cols));
-            open_mask(mptr, mstride, b.data(), a.data(), rows, cols, open_el, scratch);
-            close_mask(b.data(), cols, optr, a.data(), rows, cols, close_el, scratch);
-        } else {
-            partial = clean_regions(mptr, mstride, optr, rows, cols, open_el, close_el, regions,
-                                    scratch, a, b);
-        }
-    }
-    return py::make_tuple(out, partial);
-}
-
 }  // namespace
 
 void register_detection(py::module_& m) {
@@ -555,10 +508,4 @@ void register_detection(py::module_& m) {
         py::arg("mask"), py::arg("element"),
         "Opening (H, W) uint8 of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are "
         "single runs: cv2.morphologyEx(mask, MORPH_OPEN, element)'s values.");
-
-    m.def("clean_mask", &clean_mask, py::arg("mask"), py::arg("open_element"),
-          py::arg("close_element"), py::arg("regions") = py::none(),
-          "(mask, partial): open_mask by open_element then close_mask by close_element of a "
-          "(H, W) uint8/bool mask; with regions (K, 4) x0, y0, x1, y1, only their pixels (0 "
-          "elsewhere; partial False when the whole mask was cleaned instead).");
 }

@@ -243,16 +243,6 @@ def close_mask(mask: NDArray[Any], element: NDArray[Any]) -> NDArray[np.uint8]: 
 # opening (an erosion, then a dilation), likewise, as cv2.morphologyEx(MORPH_OPEN)
 def open_mask(mask: NDArray[Any], element: NDArray[Any]) -> NDArray[np.uint8]: ...
 
-# open_mask by open_element, then close_mask by close_element; with regions (K, 4) int x0, y0,
-# x1, y1 (half-open), only their pixels (0 elsewhere) -> (new (H, W) uint8, partial: False when
-# the regions' crops would cover the frame and the whole mask was cleaned)
-def clean_mask(
-    mask: NDArray[Any],
-    open_element: NDArray[Any],
-    close_element: NDArray[Any],
-    regions: ArrayLike | None = None,
-) -> tuple[NDArray[np.uint8], bool]: ...
-
 # boxes (K, 4) float64 cx, cy, w, h -> (K, B) float64, rows sum to 1 (0 for an empty box)
 # method "auto" | "direct" | "integral", as box_weights (the same histograms on every path)
 def box_histograms(

@@ -86,14 +86,6 @@ PFTRACK_VECTOR_CLONES static bool all_zero(const std::uint8_t* __restrict p, Ind
     return any == 0;
 }
 
-/// c[i] = c[i] where inside[i] is 0xFF, else value (inside[i] is 0 or 0xFF), i < n.
-PFTRACK_VECTOR_CLONES static void keep_inside(std::uint8_t* __restrict c,
-                                              const std::uint8_t* __restrict inside,
-                                              std::uint8_t value, Index n) {
-    for (Index i = 0; i < n; ++i)
-        c[i] = static_cast<std::uint8_t>((c[i] & inside[i]) | (value & ~inside[i]));
-}
-
 }  // namespace detail
 
 /// Scratch of `morphology`, reused from call to call.
@@ -215,117 +207,6 @@ inline void open_mask(const std::uint8_t* src, Index src_stride, std::uint8_t* d
                       const std::vector<ElementRow>& el, MorphScratch& s) {
     morphology(src, src_stride, tmp, rows, cols, el, MorphOp::erode, s);
     morphology(tmp, cols, dst, rows, cols, el, MorphOp::dilate, s);
-}
-
-/// How far (columns, rows) from a pixel the element `el` reads, on the farther side.
-inline std::pair<Index, Index> element_reach(const std::vector<ElementRow>& el) {
-    Index rx = 0, ry = 0;
-    for (const ElementRow& r : el) {
-        rx = std::max({rx, -r.lo, r.hi});
-        ry = std::max({ry, -r.dy, r.dy});
-    }
-    return {rx, ry};
-}
-
-/// A pixel rectangle [x0, x1) x [y0, y1).
-struct PixelRect {
-    Index x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-};
-
-/// The cleaning of a mask (the opening by `open_el`, then the closing by `close_el`) at the
-/// pixels of `regions` only: dst (rows x cols, packed) holds open_mask-then-close_mask's values
-/// inside every region (clipped to the image) and 0 elsewhere. Returns false, with dst the whole
-/// cleaning, when that costs no more (the estimate below).
-///
-/// Each region is cleaned on a crop of `src` grown by the four passes' reach (twice each
-/// element's, per axis). A pass computes every pixel of the crop, but a pixel within an
-/// element's reach of a crop edge that is not the image's own edge misses source pixels
-/// outside the crop, so the exact part shrinks by that reach at each pass; at an image edge the
-/// crop edge is the image edge, where both leave the outside pixels out alike. After the four
-/// passes the region itself is exact: the values of the whole-mask passes, bit for bit.
-///
-/// A pass costs about the same per row at any width up to a frame's (a row's fixed work:
-/// calls, loop tails), so the crops are not passed one by one: they are laid side by side, top
-/// aligned, on one canvas as tall as the tallest, `sep` columns apart, and each pass runs once
-/// on the canvas. Before each pass the canvas outside the crops (the columns between them, the
-/// rows under the shorter ones) is set to the pass's identity (255 for an erosion, 0 for a
-/// dilation), which never wins a minimum or maximum: each crop's values are then those of the
-/// crop passed alone, as an image of its own (`sep` is at least every element's column reach,
-/// so no crop reads another's pixels). `a` and `b` are scratch, resized here; none of src, dst,
-/// a, b may alias.
-inline bool clean_regions(const std::uint8_t* src, Index src_stride, std::uint8_t* dst,
-                          Index rows, Index cols, const std::vector<ElementRow>& open_el,
-                          const std::vector<ElementRow>& close_el,
-                          const std::vector<PixelRect>& regions, MorphScratch& s,
-                          std::vector<std::uint8_t>& a, std::vector<std::uint8_t>& b) {
-    const auto [ox, oy] = element_reach(open_el);
-    const auto [cx, cy] = element_reach(close_el);
-    const Index gx = 2 * (ox + cx), gy = 2 * (oy + cy), sep = std::max<Index>(ox, cx);
-    std::vector<std::pair<PixelRect, PixelRect>> work;  // (region, its crop), both clipped
-    Index height = 0, width = sep;  // the canvas
-    for (const PixelRect& r : regions) {
-        const PixelRect in{std::max<Index>(r.x0, 0), std::max<Index>(r.y0, 0),
-                           std::min(r.x1, cols), std::min(r.y1, rows)};
-        if (in.x0 >= in.x1 || in.y0 >= in.y1) continue;
-        const PixelRect crop{std::max<Index>(in.x0 - gx, 0), std::max<Index>(in.y0 - gy, 0),
-                             std::min(in.x1 + gx, cols), std::min(in.y1 + gy, rows)};
-        height = std::max(height, crop.y1 - crop.y0);
-        width += crop.x1 - crop.x0 + sep;
-        work.emplace_back(in, crop);
-    }
-    // a row's fixed work, counted as this many bytes of its vector work (callgrind, 480x360)
-    constexpr Index kRowCost = 256;
-    if (height * (width + kRowCost) >= rows * (cols + kRowCost)) {  // the whole costs no more
-        a.resize(static_cast<size_t>(rows * cols));
-        b.resize(static_cast<size_t>(rows * cols));
-        open_mask(src, src_stride, b.data(), a.data(), rows, cols, open_el, s);
-        close_mask(b.data(), cols, dst, a.data(), rows, cols, close_el, s);
-        return false;
-    }
-    std::memset(dst, 0, static_cast<size_t>(rows * cols));
-    if (work.empty()) return true;
-    a.resize(static_cast<size_t>(height * width));
-    b.resize(static_cast<size_t>(height * width));
-    // 0xFF on the crops, 0 outside them; the canvas outside set to `value` (before each pass:
-    // the pass's identity) by one vector blend, not a memset per row and crop
-    std::vector<std::uint8_t> inside(static_cast<size_t>(height * width), 0);
-    {
-        Index x = sep;
-        for (const auto& [in, crop] : work) {
-            const Index w = crop.x1 - crop.x0;
-            for (Index y = 0; y < crop.y1 - crop.y0; ++y)
-                std::memset(inside.data() + y * width + x, 0xFF, size_t(w));
-            x += w + sep;
-        }
-    }
-    auto outside = [&](std::uint8_t* c, std::uint8_t value) {
-        detail::keep_inside(c, inside.data(), value, height * width);
-    };
-    Index x = sep;
-    for (const auto& [in, crop] : work) {
-        const Index w = crop.x1 - crop.x0;
-        for (Index y = crop.y0; y < crop.y1; ++y)
-            std::memcpy(a.data() + (y - crop.y0) * width + x, src + y * src_stride + crop.x0,
-                        size_t(w));
-        x += w + sep;
-    }
-    outside(a.data(), 255);
-    morphology(a.data(), width, b.data(), height, width, open_el, MorphOp::erode, s);
-    outside(b.data(), 0);
-    morphology(b.data(), width, a.data(), height, width, open_el, MorphOp::dilate, s);
-    outside(a.data(), 0);
-    morphology(a.data(), width, b.data(), height, width, close_el, MorphOp::dilate, s);
-    outside(b.data(), 255);
-    morphology(b.data(), width, a.data(), height, width, close_el, MorphOp::erode, s);
-    x = sep;
-    for (const auto& [in, crop] : work) {
-        for (Index y = in.y0; y < in.y1; ++y)
-            std::memcpy(dst + y * cols + in.x0,
-                        a.data() + (y - crop.y0) * width + x + (in.x0 - crop.x0),
-                        static_cast<size_t>(in.x1 - in.x0));
-        x += crop.x1 - crop.x0 + sep;
-    }
-    return true;
 }
 
 }  // namespace pftrack

@@ -327,10 +327,6 @@ class BlobExtractor:
     _large: NDArray[np.float64] = np.zeros((0, 4))
     _large_moved: NDArray[np.bool_] = np.zeros(0, dtype=bool)
     _large_walked: NDArray[np.bool_] = np.zeros(0, dtype=bool)
-    #: the regions (K, 4) x0, y0, x1, y1 the next :meth:`clean` is read at (only_regions), and
-    #: the raw mask of the last clean() that cleaned only them (None: it cleaned the whole)
-    _regions: NDArray[np.int64] | None = None
-    partial_raw: NDArray[np.uint8] | None = None
 
     def __init__(self, config: BlobConfig) -> None:
         self.config = config
@@ -360,34 +356,16 @@ class BlobExtractor:
     def clean(self, raw: NDArray[np.uint8]) -> NDArray[np.uint8]:
         """Clean the raw mask: opening, then closing (grey-level: 127 shadows are cleaned too).
 
-        One C++ call (``pftrack._core.clean_mask``: ``open_mask``, then ``close_mask``, the GIL
-        released):
+        Each is one C++ call (``pftrack._core.open_mask``, ``close_mask``, the GIL released):
         the values of ``cv2.morphologyEx(MORPH_OPEN)`` and ``(MORPH_CLOSE)`` bit for bit
         (tests/detection/test_morphology.py), about twice as fast as OpenCV at 1280x720 (its
         generic path for the 11x11 ellipse; its separable one for the 7x7 rectangle, which the
         C++ beats by not reducing the mask's empty rows).
-
-        With :meth:`only_regions` called before, only the pixels of those regions are cleaned
-        (the same values there, 0 elsewhere: ``pftrack._core.clean_mask``), and
-        :attr:`partial_raw` keeps `raw` so that the whole can be cleaned later, on demand; when
-        the regions' crops would cover the frame the whole is cleaned and it is None.
         """
         k_open, k_close = self._elements(raw.shape[0])
-        regions, self._regions = self._regions, None
-        closed, partial = _core.clean_mask(raw, k_open, k_close, regions)
-        self.partial_raw = raw if partial else None
+        m = _core.open_mask(raw, k_open)
+        closed: NDArray[np.uint8] = _core.close_mask(m, k_close)
         return closed
-
-    def only_regions(self, regions: NDArray[np.int64] | None) -> None:
-        """Let the next :meth:`clean` clean only `regions` (K, 4) x0, y0, x1, y1 (half-open).
-
-        For a caller that reads the mask there alone (box refinement reads the boxes), through
-        a detector's ``foreground``. Said for one call: that clean() forgets it; None forgets
-        it too (call it after the detector, in case the frame was not cleaned: a dark one).
-        :attr:`partial_raw` is reset here.
-        """
-        self._regions = None if regions is None else np.asarray(regions, np.int64).reshape(-1, 4)
-        self.partial_raw = None
 
     def boxes(
         self, mask: NDArray[np.uint8], *, learn: bool = True, still: F64 | None = None

@@ -47,7 +47,6 @@ from pftrack.detection import (
     make_detector,
     refine_boxes,
 )
-from pftrack.detection.base import BlobExtractor
 from pftrack.detection.paper import PaperDetector, foreground_only
 from pftrack.particle_filter import box_histograms, hsv_bins
 from pftrack.particle_filter.filter import _in_use
@@ -157,10 +156,6 @@ class MultiObjectTracker:
     #: Calls between ``update``'s caller and the code whose line a warning names: a wrapper
     #: that calls ``update`` sets one more (:class:`pftrack.Tracker`, each frame, its own).
     caller_depth = 0
-    #: The last mask when it was cleaned at refinement's boxes only: (the detector's blob
-    #: extractor, the raw mask), for :attr:`last_mask` to clean the whole on demand (a class
-    #: default for a checkpoint pickled before).
-    _unclean: tuple[BlobExtractor, NDArray[np.uint8]] | None = None
     #: The built-in detector's objects kept (see ``__init__``): a class default for a
     #: checkpoint pickled before it was kept.
     kept_own = 0
@@ -422,10 +417,7 @@ class MultiObjectTracker:
         boxes, scores, labels = given
         mask, binned, shaded = None, None, False
         if cfg.refine.enabled or cfg.sampler == "rjmcmc":
-            # refinement reads the mask at the boxes alone; the joint sampler reads all of it
-            mask, binned, shaded = self._foreground(
-                frame, boxes if cfg.sampler != "rjmcmc" else None
-            )
+            mask, binned, shaded = self._foreground(frame)
         if binned is None:  # full-frame bins: the detector's fused pass made them, or lazy ones
             binned = hsv_bins(frame, None, cfg.binning, lazy=self._lazy)  # (only pixels read)
         # kept while the camera moves: the detector's noise-adaptive threshold keeps the mask
@@ -471,10 +463,6 @@ class MultiObjectTracker:
         A mask with shadows (refinement's, :meth:`shadows_of`) is thresholded here, on demand:
         only the joint sampler reads it on every frame.
         """
-        if self._unclean is not None:  # cleaned at the boxes only: the whole, now
-            blobs, raw = self._unclean
-            self._unclean = None
-            self._mask, self._mask_shaded = blobs.clean(raw), True
         if self._mask_shaded and self._mask is not None:
             self._mask, self._mask_shaded = foreground_only(self._mask), False
         return self._mask
@@ -493,50 +481,28 @@ class MultiObjectTracker:
             cached = self._shadows = (detector, wants and takes_shadows(detector))
         return cached[1]
 
-    def _foreground(
-        self, frame: NDArray[np.uint8], read_xywh: F64 | None = None
-    ) -> tuple[NDArray[np.uint8], Any, bool]:
+    def _foreground(self, frame: NDArray[np.uint8]) -> tuple[NDArray[np.uint8], Any, bool]:
         """Return the mask, full-frame bins (or None) and whether the mask has shadows (127).
 
         From the detector's ``foreground`` when it has one (no blob pass), with shadows when
-        :meth:`shadows_of` says so, else its ``detect``. With `read_xywh`, boxes (K, 4) that
-        are the only part of the mask read this frame (refinement's), the paper's detector in
-        this thread cleans the mask there alone (:meth:`BlobExtractor.only_regions`: the same
-        bytes there, 0 elsewhere); :attr:`last_mask` cleans the whole when asked.
+        :meth:`shadows_of` says so, else its ``detect``.
         """
         detector = self._ensure_detector()
         shaded = False
-        self._unclean = None
-        blobs = getattr(detector, "_blobs", None) if read_xywh is not None else None
-        if not (isinstance(blobs, BlobExtractor) and self._lazy_bins_from(detector)):
-            blobs = None  # (a detector on another thread, DetectAhead's, cleans the whole)
-        elif read_xywh is not None:
-            # the pixels refine_boxes reads: [floor(x), ceil(x + w)) x [floor(y), ceil(y + h))
-            x0, y0 = np.floor(read_xywh[:, 0]), np.floor(read_xywh[:, 1])
-            x1 = np.ceil(read_xywh[:, 0] + read_xywh[:, 2])
-            y1 = np.ceil(read_xywh[:, 1] + read_xywh[:, 3])
-            blobs.only_regions(np.column_stack([x0, y0, x1, y1]).astype(np.int64))
-        try:
-            if hasattr(detector, "foreground"):
-                shaded = self.shadows_of(detector)
-                # In this thread, the paper's detector leaves the bins to the tracker's lazy
-                # ones (binned where the boxes read: cheaper than its fused pass binning every
-                # pixel); a detector on its own thread (DetectAhead's stand-in), or RJ-MCMC
-                # (which reads every pixel), keeps the fused bins.
-                kw = {"bins": False} if self._lazy_bins_from(detector) else {}
-                if shaded:
-                    mask, frame_bins = detector.foreground(frame, shadows=True, **kw)
-                else:
-                    mask, frame_bins = detector.foreground(frame, **kw)
+        if hasattr(detector, "foreground"):
+            shaded = self.shadows_of(detector)
+            # In this thread, the paper's detector leaves the bins to the tracker's lazy ones
+            # (binned where the boxes read: cheaper than its fused pass binning every pixel);
+            # a detector on its own thread (DetectAhead's stand-in), or RJ-MCMC (which reads
+            # every pixel), keeps the fused bins.
+            kw = {"bins": False} if self._lazy_bins_from(detector) else {}
+            if shaded:
+                mask, frame_bins = detector.foreground(frame, shadows=True, **kw)
             else:
-                det = detector.detect(frame)
-                mask, frame_bins = det.mask, det.frame_bins
-        finally:
-            if blobs is not None:
-                raw = blobs.partial_raw
-                blobs.only_regions(None)  # not cleaned (a dark frame): not the next clean's
-                if raw is not None:
-                    self._unclean = (blobs, raw)
+                mask, frame_bins = detector.foreground(frame, **kw)
+        else:
+            det = detector.detect(frame)
+            mask, frame_bins = det.mask, det.frame_bins
         self._mask, self._mask_shaded = mask, shaded
         return mask, frame_bins, shaded
 
