@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -402,6 +403,129 @@ PFTRACK_VECTOR_CLONES static void background_row_update_held(
     }
 }
 
+/// Whether `BackgroundModel::apply` may take `background_row_fused_avx2` where the CPU has
+/// AVX2 (true unless a test turns it off to hold the portable loops, `background_row_split`
+/// then `background_row_candidates_update`, to the same reference on the same machine).
+inline std::atomic<bool>& avx2_rows_allowed() {
+    static std::atomic<bool> allowed{true};
+    return allowed;
+}
+
+#ifdef PFTRACK_LUT_GATHER
+/// |a - c| of 16 bytes: (a -sat c) | (c -sat a).
+__attribute__((target("avx2"), always_inline)) inline __m128i absdiff_u8(__m128i a, __m128i c) {
+    return _mm_or_si128(_mm_subs_epu8(a, c), _mm_subs_epu8(c, a));
+}
+
+/// Bytes 8 half .. 8 half + 7 of v as 8 floats.
+__attribute__((target("avx2"), always_inline)) inline __m256 bytes8_floats(__m128i v, int half) {
+    return _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(half == 0 ? v : _mm_unpackhi_epi64(v, v)));
+}
+
+/// `background_row_split` then `background_row_candidates_update` of the first n - n % 16
+/// pixels of a row (returned), by hand in AVX2, for a pass without bins or hold row: per
+/// `kCandidateChunk` (16) pixels, the 48 bytes split into B, G, R by byte shuffles, d_prev as
+/// the bytes' largest absolute difference (an integer: the same float), and the planes widened
+/// to floats in registers, so the B, G, R and d_prev floats are not written and read back
+/// (GCC's stride-3 deinterleave and its widening were 5 instructions a pixel, the float
+/// planes' stores and loads 1 more). The same float operations, in the same order and without
+/// FMA, as `difference` and the update: the same bits. The B, G, R floats and the candidate
+/// flags are written only in a chunk with a candidate, whose shadow test (`mask_byte`) reads
+/// them; `dprev` is not written.
+__attribute__((target("avx2"))) inline Index background_row_fused_avx2(
+    Index n, const std::uint8_t* __restrict px, std::uint8_t* __restrict pb,
+    std::uint8_t* __restrict pg, std::uint8_t* __restrict pr, const float* __restrict qb,
+    const float* __restrict qg, const float* __restrict qr, float t, float t_low,
+    ShadowBounds sh, std::int32_t* __restrict di, float* __restrict fb, float* __restrict fg,
+    float* __restrict fr, float* __restrict cand, std::uint8_t* __restrict m, float a_bg,
+    float a_fg, float* __restrict ub, float* __restrict ug, float* __restrict ur) {
+    static_assert(kCandidateChunk == 16, "one chunk is one 16-pixel step");
+    // byte k of the 48 is channel k % 3 of pixel k / 3: bytes 0-15 in `lo`, 16-31 in `mid`,
+    // 32-47 in `hi`; each channel is the OR of three shuffles (-1: a zero byte)
+    const __m128i b_lo = _mm_setr_epi8(0, 3, 6, 9, 12, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m128i b_mid = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, 2, 5, 8, 11, 14, -1, -1, -1, -1, -1);
+    const __m128i b_hi = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 1, 4, 7, 10, 13);
+    const __m128i g_lo = _mm_setr_epi8(1, 4, 7, 10, 13, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m128i g_mid = _mm_setr_epi8(-1, -1, -1, -1, -1, 0, 3, 6, 9, 12, 15, -1, -1, -1, -1, -1);
+    const __m128i g_hi = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 2, 5, 8, 11, 14);
+    const __m128i r_lo = _mm_setr_epi8(2, 5, 8, 11, 14, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m128i r_mid = _mm_setr_epi8(-1, -1, -1, -1, -1, 1, 4, 7, 10, 13, -1, -1, -1, -1, -1, -1);
+    const __m128i r_hi = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 3, 6, 9, 12, 15);
+    const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    const __m256 vt = _mm256_set1_ps(t), vt_low = _mm256_set1_ps(t_low);
+    const __m256 v255 = _mm256_set1_ps(255.0f), one = _mm256_set1_ps(1.0f);
+    const __m256 va_bg = _mm256_set1_ps(a_bg), va_fg = _mm256_set1_ps(a_fg);
+    Index x = 0;
+    for (; x + kCandidateChunk <= n; x += kCandidateChunk) {
+        const std::uint8_t* p = px + 3 * x;
+        const __m128i lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+        const __m128i mid = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 16));
+        const __m128i hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 32));
+        const __m128i b = _mm_or_si128(_mm_or_si128(_mm_shuffle_epi8(lo, b_lo),
+                                                    _mm_shuffle_epi8(mid, b_mid)),
+                                       _mm_shuffle_epi8(hi, b_hi));
+        const __m128i g = _mm_or_si128(_mm_or_si128(_mm_shuffle_epi8(lo, g_lo),
+                                                    _mm_shuffle_epi8(mid, g_mid)),
+                                       _mm_shuffle_epi8(hi, g_hi));
+        const __m128i r = _mm_or_si128(_mm_or_si128(_mm_shuffle_epi8(lo, r_lo),
+                                                    _mm_shuffle_epi8(mid, r_mid)),
+                                       _mm_shuffle_epi8(hi, r_hi));
+        // d_prev = max_c |I_c - I'_c| in bytes
+        const __m128i ob = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pb + x));
+        const __m128i og = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pg + x));
+        const __m128i orr = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pr + x));
+        const __m128i dp = _mm_max_epu8(absdiff_u8(b, ob),
+                                           _mm_max_epu8(absdiff_u8(g, og), absdiff_u8(r, orr)));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(pb + x), b);  // I' <- I
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(pg + x), g);
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(pr + x), r);
+        __m256 cf[2], ff[2][3];
+        for (int half = 0; half < 2; ++half) {
+            const Index i = x + 8 * half;  // pixels i .. i + 7
+            const __m256 vb = bytes8_floats(b, half), vg = bytes8_floats(g, half),
+                         vr = bytes8_floats(r, half), vdp = bytes8_floats(dp, half);
+            const __m256 wb = _mm256_loadu_ps(qb + i), wg = _mm256_loadu_ps(qg + i),
+                         wr = _mm256_loadu_ps(qr + i);
+            // `difference`: frame_c - background_c, also the update's
+            const __m256 eb = _mm256_sub_ps(vb, wb), eg = _mm256_sub_ps(vg, wg),
+                         er = _mm256_sub_ps(vr, wr);
+            const __m256 d = _mm256_max_ps(
+                _mm256_and_ps(eb, abs_mask),
+                _mm256_max_ps(_mm256_and_ps(eg, abs_mask), _mm256_and_ps(er, abs_mask)));
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(di + i),
+                                _mm256_cvttps_epi32(_mm256_min_ps(d, v255)));
+            const __m256 c = _mm256_or_ps(
+                _mm256_cmp_ps(d, vt, _CMP_GT_OQ),
+                _mm256_and_ps(_mm256_cmp_ps(vdp, vt, _CMP_GT_OQ),
+                              _mm256_cmp_ps(d, vt_low, _CMP_GT_OQ)));
+            // the update: background_c + a (frame_c - background_c), a_fg where a candidate
+            const __m256 a = _mm256_blendv_ps(va_bg, va_fg, c);
+            _mm256_storeu_ps(ub + i, _mm256_add_ps(wb, _mm256_mul_ps(a, eb)));
+            _mm256_storeu_ps(ug + i, _mm256_add_ps(wg, _mm256_mul_ps(a, eg)));
+            _mm256_storeu_ps(ur + i, _mm256_add_ps(wr, _mm256_mul_ps(a, er)));
+            cf[half] = c;
+            ff[half][0] = vb;
+            ff[half][1] = vg;
+            ff[half][2] = vr;
+        }
+        if (_mm256_movemask_ps(_mm256_or_ps(cf[0], cf[1])) == 0) {
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(m + x), _mm_setzero_si128());
+            continue;
+        }
+        for (int half = 0; half < 2; ++half) {
+            const Index i = x + 8 * half;
+            _mm256_storeu_ps(fb + i, ff[half][0]);
+            _mm256_storeu_ps(fg + i, ff[half][1]);
+            _mm256_storeu_ps(fr + i, ff[half][2]);
+            _mm256_storeu_ps(cand + i, _mm256_and_ps(cf[half], one));
+        }
+        for (Index i = x; i < x + kCandidateChunk; ++i)
+            m[i] = mask_byte(cand[i] != 0.0f, fb[i], fg[i], fr[i], qb[i], qg[i], qr[i], sh);
+    }
+    return x;
+}
+#endif
+
 }  // namespace detail
 
 /// Adaptive background with the paper's selective update. The first frame (or `set_background`)
@@ -610,6 +734,13 @@ public:
         // that the differences' loop can write the update while the shadow test after it still
         // reads this frame's background.
         next_.resize(background_.size());
+        // the hand-written AVX2 row pass: only without bins (their pass reads the float planes
+        // of every pixel) and without a hold row (its update reads the candidate flags)
+        bool fused = false;
+#ifdef PFTRACK_LUT_GATHER
+        fused = bins == nullptr && hold == nullptr && __builtin_cpu_supports("avx2") &&
+                detail::avx2_rows_allowed().load(std::memory_order_relaxed);
+#endif
         // Each row in three or four loops over L1-resident row buffers: (1), (2), (3) are
         // vectorised by the compiler (the shadow test of (2) too, over every pixel of each
         // 16-pixel chunk that has a candidate, skipped in the others: cheaper than branching
@@ -623,15 +754,31 @@ public:
             std::uint8_t* __restrict prev = previous_.data() + y * n3;  // planar, as qb
             std::int16_t* __restrict o = bins != nullptr ? bins + y * cols : nullptr;
             std::uint8_t* __restrict m = mask + y * cols;
+            // (1) + (2) without bins or hold row, where the CPU has AVX2: by hand, 16 pixels a
+            //     step, the frame's floats kept in registers; the row's last cols % 16 pixels
+            //     by the loops below
+            Index done = 0;
+#ifdef PFTRACK_LUT_GATHER
+            if (fused)
+                done = detail::background_row_fused_avx2(
+                    cols, px, prev, prev + cols, prev + 2 * cols, qb, qg, qr, t, t_low, sh, di, fb,
+                    fg, fr, cand, m, a_bg, a_fg, ub, ub + cols, ub + 2 * cols);
+#endif
+            if (done == cols) {
+                histogram_row(h8, di, cols);
+                continue;
+            }
             // (1) deinterleave into float planes, d_prev; I' <- I
-            detail::background_row_split(cols, px, prev, prev + cols, prev + 2 * cols, fb, fg, fr,
-                                         dprev);
+            detail::background_row_split(cols - done, px + 3 * done, prev + done,
+                                         prev + cols + done, prev + 2 * cols + done, fb + done,
+                                         fg + done, fr + done, dprev + done);
             // (2) per pixel: d_bg, candidates, mask, and (without a hold row) the selective
             //     update background_c + a (frame_c - background_c) into the next buffer
             if (hold == nullptr)
-                detail::background_row_candidates_update(cols, fb, fg, fr, qb, qg, qr, dprev, t,
-                                                         t_low, sh, di, cand, m, a_bg, a_fg, ub,
-                                                         ub + cols, ub + 2 * cols);
+                detail::background_row_candidates_update(
+                    cols - done, fb + done, fg + done, fr + done, qb + done, qg + done, qr + done,
+                    dprev + done, t, t_low, sh, di + done, cand + done, m + done, a_bg, a_fg,
+                    ub + done, ub + cols + done, ub + 2 * cols + done);
             else
                 detail::background_row_candidates(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low,
                                                   sh, di, cand, m);
@@ -641,12 +788,7 @@ public:
             if (o != nullptr)
                 for (Index x = 0; x < cols; ++x)
                     o[x] = static_cast<std::int16_t>(lut_.bin_at(si[x], hi[x]));
-            //     pixel x into copy x mod 8: eight at a time, each copy's address fixed (was
-            //     9 instructions a pixel, the copy's address computed from x; now about 2.4)
-            Index x = 0;
-            for (; x + 8 <= cols; x += 8)
-                for (size_t q = 0; q < 8; ++q) ++h8[q][static_cast<size_t>(di[x + static_cast<Index>(q)])];
-            for (; x < cols; ++x) ++h8[static_cast<size_t>(x & 7)][static_cast<size_t>(di[x])];
+            histogram_row(h8, di, cols);
             // (5) with a hold row, the selective update (a = 0 under the hold) into the next buffer
             if (hold != nullptr)
                 detail::background_row_update_held(cols, fb, fg, fr, qb, qg, qr, cand,
@@ -661,6 +803,17 @@ public:
         }
         threshold_ = next_threshold();
         ++frame_count_;
+    }
+
+    /// floor(d_bg) of a row's n pixels (`di`) counted into `h8`, pixel x into copy x mod 8:
+    /// eight at a time, each copy's address fixed (was 9 instructions a pixel, the copy's
+    /// address computed from x; now about 2.4).
+    static void histogram_row(std::array<std::array<std::int32_t, 256>, 8>& h8,
+                              const std::int32_t* di, Index n) {
+        Index x = 0;
+        for (; x + 8 <= n; x += 8)
+            for (size_t q = 0; q < 8; ++q) ++h8[q][static_cast<size_t>(di[x + static_cast<Index>(q)])];
+        for (; x < n; ++x) ++h8[static_cast<size_t>(x & 7)][static_cast<size_t>(di[x])];
     }
 
     /// Everything a model has learnt (not its settings, not per-call scratch): what a pickled
