@@ -492,12 +492,12 @@ void register_detection(py::module_& m) {
         "(numpy's frame[::step, ::step].mean(), the same double).");
 
     m.def(
-        "_set_avx2_rows",
-        [](bool allowed) { return detail::avx2_rows_allowed().exchange(allowed); },
+        "_set_avx2",
+        [](bool allowed) { return detail::avx2_allowed().exchange(allowed); },
         py::arg("allowed"),
-        "Testing hook: whether BackgroundModel.apply may take its hand-written AVX2 row pass "
-        "(where the CPU has AVX2; the portable loops otherwise, the same results). Returns the "
-        "previous setting; process-wide.");
+        "Testing hook: whether background.hpp's hand-written AVX2 passes may run (BackgroundModel."
+        "apply's row pass, hsv_bins' rows; where the CPU has AVX2; the portable loops otherwise, "
+        "the same results). Returns the previous setting; process-wide.");
 
     m.def(
         "close_mask",

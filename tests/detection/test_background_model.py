@@ -33,9 +33,9 @@ def avx2_rows(request: pytest.FixtureRequest):
     `background_row_fused_avx2`; with the hook off, through the portable loops (the ones every
     other CPU runs). Both are held to the same NumPy reference.
     """
-    before = _core._set_avx2_rows(request.param)
+    before = _core._set_avx2(request.param)
     yield request.param
-    _core._set_avx2_rows(before)
+    _core._set_avx2(before)
 
 
 def test_lut_bins_equal_hsv_bins_on_every_colour():
@@ -192,10 +192,10 @@ def test_avx2_rows_hook_gives_the_same_pass_on_a_large_frame():
     rng = np.random.default_rng(71)
     frames = random_scene(rng, shape=(360, 487), steps=6)
     outs = []
-    before = _core._set_avx2_rows(False)
+    before = _core._set_avx2(False)
     try:
         for allowed in (True, False):
-            assert _core._set_avx2_rows(allowed) is (not allowed)  # returns the previous value
+            assert _core._set_avx2(allowed) is (not allowed)  # returns the previous value
             model = _core.BackgroundModel(n_learn=2)
             out = []
             for f in frames:
@@ -203,7 +203,7 @@ def test_avx2_rows_hook_gives_the_same_pass_on_a_large_frame():
                 out.append((mask, model.background, model.difference_histogram, model.threshold))
             outs.append(out)
     finally:
-        _core._set_avx2_rows(before)
+        _core._set_avx2(before)
     for (m1, b1, h1, t1), (m2, b2, h2, t2) in zip(*outs):
         np.testing.assert_array_equal(m1, m2)
         np.testing.assert_array_equal(b1, b2)

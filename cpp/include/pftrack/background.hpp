@@ -16,6 +16,7 @@
 
 #include "check.hpp"
 #include "hsv.hpp"
+#include "mask_scan.hpp"
 #include "types.hpp"
 
 // HsvLut::bins_of_row's AVX2 pass (byte shuffles, table gathers), chosen at run time: GCC's
@@ -26,6 +27,19 @@
 #endif
 
 namespace pftrack {
+
+namespace detail {
+
+/// Whether this file's hand-written AVX2 passes may run where the CPU has AVX2
+/// (`background_row_fused_avx2`, `HsvLut::bins_of_row`, and so `hsv_bins_image`'s): true unless
+/// a test turns it off (`pftrack._core._set_avx2`) to hold the portable loops, which other CPUs
+/// run, to the same reference on the same machine.
+inline std::atomic<bool>& avx2_allowed() {
+    static std::atomic<bool> allowed{true};
+    return allowed;
+}
+
+}  // namespace detail
 
 /// `hsv_bin_of` as table look-ups, without branches: identical results (tests check all 2^24
 /// colours), several times faster. The colour/grey decision and the saturation bin depend on
@@ -84,7 +98,9 @@ public:
     /// the caller then takes `hsv_row_indices` and `bin_at`.
     bool bins_of_row(Index n, const std::uint8_t* px, std::int16_t* out) const {
 #ifdef PFTRACK_LUT_GATHER
-        if (!__builtin_cpu_supports("avx2")) return false;
+        if (!__builtin_cpu_supports("avx2") ||
+            !detail::avx2_allowed().load(std::memory_order_relaxed))
+            return false;
         Index x = bins_of_row_avx2(n, px, out);
         for (; x < n; ++x)
             out[x] = static_cast<std::int16_t>(bin(px[3 * x], px[3 * x + 1], px[3 * x + 2]));
@@ -401,14 +417,6 @@ PFTRACK_VECTOR_CLONES static void background_row_update_held(
         ug[x] = qg[x] + a * (fg[x] - qg[x]);
         ur[x] = qr[x] + a * (fr[x] - qr[x]);
     }
-}
-
-/// Whether `BackgroundModel::apply` may take `background_row_fused_avx2` where the CPU has
-/// AVX2 (true unless a test turns it off to hold the portable loops, `background_row_split`
-/// then `background_row_candidates_update`, to the same reference on the same machine).
-inline std::atomic<bool>& avx2_rows_allowed() {
-    static std::atomic<bool> allowed{true};
-    return allowed;
 }
 
 #ifdef PFTRACK_LUT_GATHER
@@ -739,7 +747,7 @@ public:
         bool fused = false;
 #ifdef PFTRACK_LUT_GATHER
         fused = bins == nullptr && hold == nullptr && __builtin_cpu_supports("avx2") &&
-                detail::avx2_rows_allowed().load(std::memory_order_relaxed);
+                detail::avx2_allowed().load(std::memory_order_relaxed);
 #endif
         // Each row in three or four loops over L1-resident row buffers: (1), (2), (3) are
         // vectorised by the compiler (the shadow test of (2) too, over every pixel of each
@@ -1043,6 +1051,13 @@ PFTRACK_VECTOR_CLONES static void mask_bins_row(const std::int16_t* __restrict s
         o[x] = static_cast<std::int16_t>(src[x] | -static_cast<std::int16_t>(m[x] == 0));
 }
 
+/// `mask_bins_row` in place: o[x] = -1 where m[x] is 0.
+PFTRACK_VECTOR_CLONES static void mask_bins_in_place(std::int16_t* __restrict o,
+                                                     const std::uint8_t* __restrict m, Index n) {
+    for (Index x = 0; x < n; ++x)
+        o[x] = static_cast<std::int16_t>(o[x] | -static_cast<std::int16_t>(m[x] == 0));
+}
+
 }  // namespace detail
 
 /// `HsvLut::bin` of every pixel of a BGR frame (rows x cols, `row_stride` bytes a row) into
@@ -1075,11 +1090,21 @@ inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index row
         std::fill(o, o + cols, std::int16_t(-1));
         Index x = 0;
         while (x < cols) {
+            x = detail::skip_zero_words(m, x, cols);  // most rows are background
             if (x + 8 <= cols) {
                 std::uint64_t word;
-                std::memcpy(&word, m + x, 8);
-                if (word == 0) {
-                    x += 8;
+                // a run of 8-pixel groups that each hold a masked pixel (a blob's row): binned
+                // whole by `bins_of_row` (AVX2: about 5 instructions a pixel, against 25 for
+                // one pixel's `bin`), then -1 where the mask is 0
+                Index end = x + 8;
+                while (end + 8 <= cols) {
+                    std::memcpy(&word, m + end, 8);
+                    if (word == 0) break;
+                    end += 8;
+                }
+                if (lut.bins_of_row(end - x, px + 3 * x, o + x)) {
+                    detail::mask_bins_in_place(o + x, m + x, end - x);
+                    x = end;
                     continue;
                 }
             }
