@@ -160,25 +160,27 @@ def test_rows_without_bins_or_hold_match_the_reference(cols, kw, avx2_rows):
     # previous frame it keeps against the NumPy reference, bit for bit
     rng = np.random.default_rng(cols)
     model, ref = _core.BackgroundModel(**kw), BackgroundReference(**kw)
+    low_ratio = kw.get("low_ratio", 0.5)
     n_fg = n_shadow = n_moved = 0
-    for k, frame in enumerate(random_scene(rng, shape=(23, cols), steps=8)):
+    last: tuple[np.ndarray, np.ndarray, float] | None = None  # background, frame, threshold
+    for frame in random_scene(rng, shape=(23, cols), steps=8):
         none, mask = model.apply(frame, bins=False)
         _, rmask = ref.apply(frame)
         assert none is None
         np.testing.assert_array_equal(mask, rmask)
         np.testing.assert_array_equal(model.background, ref.background)
         assert model.__getstate__()[4] == frame.tobytes()  # the previous frame, as given
-        if k > 0:
+        if last is not None:
             np.testing.assert_array_equal(model.difference_histogram, ref.hist)
             # candidates by the frame difference alone (hysteresis: d_prev > T, d_bg in
             # (low_ratio T, T]), which the row pass decides from the previous frame's bytes
-            d_bg = np.abs(frame.astype(np.float32) - before).max(axis=2)
+            background, previous, threshold = last
+            d_bg = np.abs(frame.astype(np.float32) - background).max(axis=2)
             d_prev = np.abs(frame.astype(np.int32) - previous).max(axis=2)
-            t = np.float32(threshold)
-            n_moved += int(((d_prev > t) & (d_bg > np.float32(low * threshold)) & (d_bg <= t)).sum())
+            t, t_low = np.float32(threshold), np.float32(low_ratio * threshold)
+            n_moved += int(((d_prev > t) & (d_bg > t_low) & (d_bg <= t)).sum())
         assert model.threshold == pytest.approx(ref.threshold, abs=1e-12)
-        before, previous = ref.background.copy(), frame.astype(np.int32)
-        threshold, low = model.threshold, kw.get("low_ratio", 0.5)
+        last = ref.background.copy(), frame.astype(np.int32), model.threshold
         n_fg += int((mask == 255).sum())
         n_shadow += int((mask == 127).sum())
     assert n_fg > 0 or cols == 1  # the moving patches start at column 4
@@ -204,7 +206,7 @@ def test_avx2_rows_hook_gives_the_same_pass_on_a_large_frame():
             outs.append(out)
     finally:
         _core._set_avx2(before)
-    for (m1, b1, h1, t1), (m2, b2, h2, t2) in zip(*outs):
+    for (m1, b1, h1, t1), (m2, b2, h2, t2) in zip(*outs, strict=True):
         np.testing.assert_array_equal(m1, m2)
         np.testing.assert_array_equal(b1, b2)
         np.testing.assert_array_equal(h1, h2)

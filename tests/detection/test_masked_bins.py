@@ -46,7 +46,8 @@ def test_masked_bins_of_runs_blobs_and_lone_pixels(cols, avx2):
         got = _core.hsv_bins(frame, mask, **kw).bins
         np.testing.assert_array_equal(got, masked_reference(frame, mask, **kw))
         # the unmasked bins: the whole-row AVX2 pass, or the portable indices and look-ups
-        np.testing.assert_array_equal(_core.hsv_bins(frame, **kw).bins, hsv_bin_reference(frame, **kw))
+        want = hsv_bin_reference(frame, **kw)
+        np.testing.assert_array_equal(_core.hsv_bins(frame, **kw).bins, want)
 
 
 def test_masked_bins_of_a_strided_frame_and_mask(avx2):

@@ -1064,9 +1064,10 @@ PFTRACK_VECTOR_CLONES static void mask_bins_in_place(std::int16_t* __restrict o,
 /// `out` (rows x cols, packed), -1 where `mask` (if not null, `mask_stride` bytes a row) is 0: a
 /// whole row by `HsvLut::bins_of_row` (AVX2), else the table indices of the row by the
 /// vectorised `hsv_row_indices`, then the look-ups (the same bins as `HsvLut::bin` pixel by
-/// pixel, several times faster). With a mask, only the masked
-/// pixels are binned, one by one: a foreground mask leaves most pixels out, and most rows empty
-/// (skipped eight bytes at a time). `out_stride` is in elements: the bins of one rectangle of a
+/// pixel, several times faster). With a mask, only the 8-pixel groups that hold a masked pixel
+/// are binned: a foreground mask leaves most pixels out, and most rows empty (skipped 32, then
+/// 8 bytes at a time: `skip_zero_words`); each run of such groups by `bins_of_row`, then -1
+/// where the mask is 0 (without AVX2: the masked pixels one by one). `out_stride` is in elements: the bins of one rectangle of a
 /// larger image (each pixel's bin depends on that pixel only, so any rectangle gets the bins the
 /// whole image would).
 inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index rows, Index cols,
