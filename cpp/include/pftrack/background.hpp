@@ -451,13 +451,15 @@ __attribute__((target("avx2"))) inline Index background_row_fused_avx2(
     // byte k of the 48 is channel k % 3 of pixel k / 3: bytes 0-15 in `lo`, 16-31 in `mid`,
     // 32-47 in `hi`; each channel is the OR of three shuffles (-1: a zero byte)
     const __m128i b_lo = _mm_setr_epi8(0, 3, 6, 9, 12, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
-    const __m128i b_mid = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, 2, 5, 8, 11, 14, -1, -1, -1, -1, -1);
+    const __m128i b_mid =
+        _mm_setr_epi8(-1, -1, -1, -1, -1, -1, 2, 5, 8, 11, 14, -1, -1, -1, -1, -1);
     const __m128i b_hi = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 1, 4, 7, 10, 13);
     const __m128i g_lo = _mm_setr_epi8(1, 4, 7, 10, 13, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
     const __m128i g_mid = _mm_setr_epi8(-1, -1, -1, -1, -1, 0, 3, 6, 9, 12, 15, -1, -1, -1, -1, -1);
     const __m128i g_hi = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 2, 5, 8, 11, 14);
     const __m128i r_lo = _mm_setr_epi8(2, 5, 8, 11, 14, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
-    const __m128i r_mid = _mm_setr_epi8(-1, -1, -1, -1, -1, 1, 4, 7, 10, 13, -1, -1, -1, -1, -1, -1);
+    const __m128i r_mid =
+        _mm_setr_epi8(-1, -1, -1, -1, -1, 1, 4, 7, 10, 13, -1, -1, -1, -1, -1, -1);
     const __m128i r_hi = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 3, 6, 9, 12, 15);
     const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
     const __m256 vt = _mm256_set1_ps(t), vt_low = _mm256_set1_ps(t_low);
@@ -820,7 +822,8 @@ public:
                               const std::int32_t* di, Index n) {
         Index x = 0;
         for (; x + 8 <= n; x += 8)
-            for (size_t q = 0; q < 8; ++q) ++h8[q][static_cast<size_t>(di[x + static_cast<Index>(q)])];
+            for (size_t q = 0; q < 8; ++q)
+                ++h8[q][static_cast<size_t>(di[x + static_cast<Index>(q)])];
         for (; x < n; ++x) ++h8[static_cast<size_t>(x & 7)][static_cast<size_t>(di[x])];
     }
 
@@ -1067,9 +1070,9 @@ PFTRACK_VECTOR_CLONES static void mask_bins_in_place(std::int16_t* __restrict o,
 /// pixel, several times faster). With a mask, only the 8-pixel groups that hold a masked pixel
 /// are binned: a foreground mask leaves most pixels out, and most rows empty (skipped 32, then
 /// 8 bytes at a time: `skip_zero_words`); each run of such groups by `bins_of_row`, then -1
-/// where the mask is 0 (without AVX2: the masked pixels one by one). `out_stride` is in elements: the bins of one rectangle of a
-/// larger image (each pixel's bin depends on that pixel only, so any rectangle gets the bins the
-/// whole image would).
+/// where the mask is 0 (without AVX2: the masked pixels one by one). `out_stride` is in
+/// elements: the bins of one rectangle of a larger image (each pixel's bin depends on that pixel
+/// only, so any rectangle gets the bins the whole image would).
 inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index rows, Index cols,
                            Index row_stride, const std::uint8_t* mask, Index mask_stride,
                            std::int16_t* out, Index out_stride) {
