@@ -492,6 +492,14 @@ void register_detection(py::module_& m) {
         "(numpy's frame[::step, ::step].mean(), the same double).");
 
     m.def(
+        "_set_avx2",
+        [](bool allowed) { return detail::avx2_allowed().exchange(allowed); },
+        py::arg("allowed"),
+        "Testing hook: whether background.hpp's hand-written AVX2 passes may run (BackgroundModel."
+        "apply's row pass, hsv_bins' rows; where the CPU has AVX2; the portable loops otherwise, "
+        "the same results). Returns the previous setting; process-wide.");
+
+    m.def(
         "close_mask",
         [](const py::object& mask, const py::object& element) {
             return mask_pass(mask, element, "close_mask", close_mask);

@@ -25,6 +25,19 @@ def random_scene(rng: np.random.Generator, shape=(48, 64), steps=6) -> list[np.n
     return frames
 
 
+@pytest.fixture(params=[True, False], ids=["avx2-rows", "portable-rows"])
+def avx2_rows(request: pytest.FixtureRequest):
+    """Whether apply may take its hand-written AVX2 row pass (stop 71): each test runs twice.
+
+    Without bins and without a hold row, on a CPU with AVX2, apply's rows go through
+    `background_row_fused_avx2`; with the hook off, through the portable loops (the ones every
+    other CPU runs). Both are held to the same NumPy reference.
+    """
+    before = _core._set_avx2(request.param)
+    yield request.param
+    _core._set_avx2(before)
+
+
 def test_lut_bins_equal_hsv_bins_on_every_colour():
     v = np.arange(1 << 24, dtype=np.uint32)
     img = (
@@ -118,7 +131,7 @@ def test_background_model_matches_reference(seed, kw):
 
 
 @pytest.mark.parametrize("bins", [True, False])
-def test_background_model_matches_reference_at_odd_widths(bins):
+def test_background_model_matches_reference_at_odd_widths(bins, avx2_rows):
     # the vectorised row loops (mask and shadow test included) and their scalar remainders
     for cols in (7, 61, 133):
         rng = np.random.default_rng(cols)
@@ -134,6 +147,71 @@ def test_background_model_matches_reference_at_odd_widths(bins):
             assert model.threshold == pytest.approx(ref.threshold, abs=1e-12)
             n_shadow += int((mask == 127).sum())
         assert n_shadow > 0 or cols < 30  # the shadowed patch was marked, where it fits
+
+
+@pytest.mark.parametrize("cols", [1, 15, 16, 17, 31, 32, 33, 48, 61, 480])
+@pytest.mark.parametrize(
+    "kw", [{"n_learn": 2}, {"n_learn": 0, "alpha_fg": 0.0, "low_ratio": 0.3, "t_min": 12.0}]
+)
+def test_rows_without_bins_or_hold_match_the_reference(cols, kw, avx2_rows):
+    # apply(bins=False) without a hold row: the AVX2 row pass (16 pixels a step: the byte
+    # shuffles of B, G and R, d_prev in bytes, the floats in registers) and its portable loops
+    # for the row's last cols % 16 pixels, or the portable loops alone; every output and the
+    # previous frame it keeps against the NumPy reference, bit for bit
+    rng = np.random.default_rng(cols)
+    model, ref = _core.BackgroundModel(**kw), BackgroundReference(**kw)
+    low_ratio = kw.get("low_ratio", 0.5)
+    n_fg = n_shadow = n_moved = 0
+    last: tuple[np.ndarray, np.ndarray, float] | None = None  # background, frame, threshold
+    for frame in random_scene(rng, shape=(23, cols), steps=8):
+        none, mask = model.apply(frame, bins=False)
+        _, rmask = ref.apply(frame)
+        assert none is None
+        np.testing.assert_array_equal(mask, rmask)
+        np.testing.assert_array_equal(model.background, ref.background)
+        assert model.__getstate__()[4] == frame.tobytes()  # the previous frame, as given
+        if last is not None:
+            np.testing.assert_array_equal(model.difference_histogram, ref.hist)
+            # candidates by the frame difference alone (hysteresis: d_prev > T, d_bg in
+            # (low_ratio T, T]), which the row pass decides from the previous frame's bytes
+            background, previous, threshold = last
+            d_bg = np.abs(frame.astype(np.float32) - background).max(axis=2)
+            d_prev = np.abs(frame.astype(np.int32) - previous).max(axis=2)
+            t, t_low = np.float32(threshold), np.float32(low_ratio * threshold)
+            n_moved += int(((d_prev > t) & (d_bg > t_low) & (d_bg <= t)).sum())
+        assert model.threshold == pytest.approx(ref.threshold, abs=1e-12)
+        last = ref.background.copy(), frame.astype(np.int32), model.threshold
+        n_fg += int((mask == 255).sum())
+        n_shadow += int((mask == 127).sum())
+    assert n_fg > 0 or cols == 1  # the moving patches start at column 4
+    assert n_shadow > 0 or cols < 30
+    assert n_moved > 0 or cols < 30
+
+
+def test_avx2_rows_hook_gives_the_same_pass_on_a_large_frame():
+    # a 360 x 487 scene (30 steps of 16 pixels and a tail of 7 a row): the two row passes
+    # give the same masks, backgrounds, histograms and thresholds frame by frame
+    rng = np.random.default_rng(71)
+    frames = random_scene(rng, shape=(360, 487), steps=6)
+    outs = []
+    before = _core._set_avx2(False)
+    try:
+        for allowed in (True, False):
+            assert _core._set_avx2(allowed) is (not allowed)  # returns the previous value
+            model = _core.BackgroundModel(n_learn=2)
+            out = []
+            for f in frames:
+                _, mask = model.apply(f, bins=False)
+                out.append((mask, model.background, model.difference_histogram, model.threshold))
+            outs.append(out)
+    finally:
+        _core._set_avx2(before)
+    for (m1, b1, h1, t1), (m2, b2, h2, t2) in zip(*outs, strict=True):
+        np.testing.assert_array_equal(m1, m2)
+        np.testing.assert_array_equal(b1, b2)
+        np.testing.assert_array_equal(h1, h2)
+        assert t1 == t2
+    assert any((o[0] == 255).any() for o in outs[0])
 
 
 @pytest.mark.parametrize("cols", [7, 61, 133])
@@ -171,7 +249,7 @@ def test_hold_of_the_wrong_shape_or_type_is_refused():
 
 @pytest.mark.parametrize("bins", [True, False])
 @pytest.mark.parametrize("cols", [32, 64, 65, 96 + 7])
-def test_shadow_test_skipped_only_in_chunks_without_candidates(bins, cols):
+def test_shadow_test_skipped_only_in_chunks_without_candidates(bins, cols, avx2_rows):
     # The row is scanned in chunks of 16 pixels (kCandidateChunk; 32 before stop 70) and the
     # shadow test runs only in chunks with a candidate: a lone foreground or shadow pixel at
     # either end of a chunk, or in the scalar tail, is marked as the reference marks it, and

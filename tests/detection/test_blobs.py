@@ -102,6 +102,22 @@ def test_only_outer_regions_in_contour_order() -> None:
     assert got.tolist() == [[45, 20, 7, 12], [5, 5, 30, 30], [40, 0, 20, 10]]  # reverse raster
 
 
+@pytest.mark.parametrize("cols", [8, 31, 32, 33, 64, 71, 100])
+def test_lone_pixels_after_empty_stretches_of_every_length(cols: int) -> None:
+    # the run scan skips empty bytes 32 a step, then 8, then one by one (stop 71): a pixel after
+    # an empty stretch of every length 0 .. cols - 1 in its row, and a pixel at both ends of
+    # another row, are each a region of their own, as OpenCV's outer contours find them
+    mask = np.zeros((2 * cols + 2, cols), np.uint8)
+    for x in range(cols):
+        mask[2 * x, x] = 255
+    mask[2 * cols, 0] = mask[2 * cols, cols - 1] = 1
+    got, _ = _core.blob_boxes(mask, 0.0, 1.0, 1e-3, 1e3, 0.0, 0.0, None, *SIZE)
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+    want = np.array([cv2.boundingRect(c) for c in contours], np.float64)
+    np.testing.assert_array_equal(got, want)
+    assert len(got) == cols + (2 if cols > 1 else 1)
+
+
 @pytest.mark.dataset
 def test_equals_reference_on_pets_masks() -> None:
     video = dataset("pets09-s2l1") / "video.avi"

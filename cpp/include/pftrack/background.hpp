@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -15,6 +16,7 @@
 
 #include "check.hpp"
 #include "hsv.hpp"
+#include "mask_scan.hpp"
 #include "types.hpp"
 
 // HsvLut::bins_of_row's AVX2 pass (byte shuffles, table gathers), chosen at run time: GCC's
@@ -25,6 +27,19 @@
 #endif
 
 namespace pftrack {
+
+namespace detail {
+
+/// Whether this file's hand-written AVX2 passes may run where the CPU has AVX2
+/// (`background_row_fused_avx2`, `HsvLut::bins_of_row`, and so `hsv_bins_image`'s): true unless
+/// a test turns it off (`pftrack._core._set_avx2`) to hold the portable loops, which other CPUs
+/// run, to the same reference on the same machine.
+inline std::atomic<bool>& avx2_allowed() {
+    static std::atomic<bool> allowed{true};
+    return allowed;
+}
+
+}  // namespace detail
 
 /// `hsv_bin_of` as table look-ups, without branches: identical results (tests check all 2^24
 /// colours), several times faster. The colour/grey decision and the saturation bin depend on
@@ -83,7 +98,9 @@ public:
     /// the caller then takes `hsv_row_indices` and `bin_at`.
     bool bins_of_row(Index n, const std::uint8_t* px, std::int16_t* out) const {
 #ifdef PFTRACK_LUT_GATHER
-        if (!__builtin_cpu_supports("avx2")) return false;
+        if (!__builtin_cpu_supports("avx2") ||
+            !detail::avx2_allowed().load(std::memory_order_relaxed))
+            return false;
         Index x = bins_of_row_avx2(n, px, out);
         for (; x < n; ++x)
             out[x] = static_cast<std::int16_t>(bin(px[3 * x], px[3 * x + 1], px[3 * x + 2]));
@@ -402,6 +419,123 @@ PFTRACK_VECTOR_CLONES static void background_row_update_held(
     }
 }
 
+#ifdef PFTRACK_LUT_GATHER
+/// |a - c| of 16 bytes: (a -sat c) | (c -sat a).
+__attribute__((target("avx2"), always_inline)) inline __m128i absdiff_u8(__m128i a, __m128i c) {
+    return _mm_or_si128(_mm_subs_epu8(a, c), _mm_subs_epu8(c, a));
+}
+
+/// Bytes 8 half .. 8 half + 7 of v as 8 floats.
+__attribute__((target("avx2"), always_inline)) inline __m256 bytes8_floats(__m128i v, int half) {
+    return _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(half == 0 ? v : _mm_unpackhi_epi64(v, v)));
+}
+
+/// `background_row_split` then `background_row_candidates_update` of the first n - n % 16
+/// pixels of a row (returned), by hand in AVX2, for a pass without bins or hold row: per
+/// `kCandidateChunk` (16) pixels, the 48 bytes split into B, G, R by byte shuffles, d_prev as
+/// the bytes' largest absolute difference (an integer: the same float), and the planes widened
+/// to floats in registers, so the B, G, R and d_prev floats are not written and read back
+/// (GCC's stride-3 deinterleave and its widening were 5 instructions a pixel, the float
+/// planes' stores and loads 1 more). The same float operations, in the same order and without
+/// FMA, as `difference` and the update: the same bits. The B, G, R floats and the candidate
+/// flags are written only in a chunk with a candidate, whose shadow test (`mask_byte`) reads
+/// them; `dprev` is not written.
+__attribute__((target("avx2"))) inline Index background_row_fused_avx2(
+    Index n, const std::uint8_t* __restrict px, std::uint8_t* __restrict pb,
+    std::uint8_t* __restrict pg, std::uint8_t* __restrict pr, const float* __restrict qb,
+    const float* __restrict qg, const float* __restrict qr, float t, float t_low,
+    ShadowBounds sh, std::int32_t* __restrict di, float* __restrict fb, float* __restrict fg,
+    float* __restrict fr, float* __restrict cand, std::uint8_t* __restrict m, float a_bg,
+    float a_fg, float* __restrict ub, float* __restrict ug, float* __restrict ur) {
+    static_assert(kCandidateChunk == 16, "one chunk is one 16-pixel step");
+    // byte k of the 48 is channel k % 3 of pixel k / 3: bytes 0-15 in `lo`, 16-31 in `mid`,
+    // 32-47 in `hi`; each channel is the OR of three shuffles (-1: a zero byte)
+    const __m128i b_lo = _mm_setr_epi8(0, 3, 6, 9, 12, 15, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m128i b_mid =
+        _mm_setr_epi8(-1, -1, -1, -1, -1, -1, 2, 5, 8, 11, 14, -1, -1, -1, -1, -1);
+    const __m128i b_hi = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 1, 4, 7, 10, 13);
+    const __m128i g_lo = _mm_setr_epi8(1, 4, 7, 10, 13, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m128i g_mid = _mm_setr_epi8(-1, -1, -1, -1, -1, 0, 3, 6, 9, 12, 15, -1, -1, -1, -1, -1);
+    const __m128i g_hi = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 2, 5, 8, 11, 14);
+    const __m128i r_lo = _mm_setr_epi8(2, 5, 8, 11, 14, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
+    const __m128i r_mid =
+        _mm_setr_epi8(-1, -1, -1, -1, -1, 1, 4, 7, 10, 13, -1, -1, -1, -1, -1, -1);
+    const __m128i r_hi = _mm_setr_epi8(-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 3, 6, 9, 12, 15);
+    const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    const __m256 vt = _mm256_set1_ps(t), vt_low = _mm256_set1_ps(t_low);
+    const __m256 v255 = _mm256_set1_ps(255.0f), one = _mm256_set1_ps(1.0f);
+    const __m256 va_bg = _mm256_set1_ps(a_bg), va_fg = _mm256_set1_ps(a_fg);
+    Index x = 0;
+    for (; x + kCandidateChunk <= n; x += kCandidateChunk) {
+        const std::uint8_t* p = px + 3 * x;
+        const __m128i lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+        const __m128i mid = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 16));
+        const __m128i hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 32));
+        const __m128i b = _mm_or_si128(_mm_or_si128(_mm_shuffle_epi8(lo, b_lo),
+                                                    _mm_shuffle_epi8(mid, b_mid)),
+                                       _mm_shuffle_epi8(hi, b_hi));
+        const __m128i g = _mm_or_si128(_mm_or_si128(_mm_shuffle_epi8(lo, g_lo),
+                                                    _mm_shuffle_epi8(mid, g_mid)),
+                                       _mm_shuffle_epi8(hi, g_hi));
+        const __m128i r = _mm_or_si128(_mm_or_si128(_mm_shuffle_epi8(lo, r_lo),
+                                                    _mm_shuffle_epi8(mid, r_mid)),
+                                       _mm_shuffle_epi8(hi, r_hi));
+        // d_prev = max_c |I_c - I'_c| in bytes
+        const __m128i ob = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pb + x));
+        const __m128i og = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pg + x));
+        const __m128i orr = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pr + x));
+        const __m128i dp = _mm_max_epu8(absdiff_u8(b, ob),
+                                           _mm_max_epu8(absdiff_u8(g, og), absdiff_u8(r, orr)));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(pb + x), b);  // I' <- I
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(pg + x), g);
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(pr + x), r);
+        __m256 cf[2], ff[2][3];
+        for (int half = 0; half < 2; ++half) {
+            const Index i = x + 8 * half;  // pixels i .. i + 7
+            const __m256 vb = bytes8_floats(b, half), vg = bytes8_floats(g, half),
+                         vr = bytes8_floats(r, half), vdp = bytes8_floats(dp, half);
+            const __m256 wb = _mm256_loadu_ps(qb + i), wg = _mm256_loadu_ps(qg + i),
+                         wr = _mm256_loadu_ps(qr + i);
+            // `difference`: frame_c - background_c, also the update's
+            const __m256 eb = _mm256_sub_ps(vb, wb), eg = _mm256_sub_ps(vg, wg),
+                         er = _mm256_sub_ps(vr, wr);
+            const __m256 d = _mm256_max_ps(
+                _mm256_and_ps(eb, abs_mask),
+                _mm256_max_ps(_mm256_and_ps(eg, abs_mask), _mm256_and_ps(er, abs_mask)));
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(di + i),
+                                _mm256_cvttps_epi32(_mm256_min_ps(d, v255)));
+            const __m256 c = _mm256_or_ps(
+                _mm256_cmp_ps(d, vt, _CMP_GT_OQ),
+                _mm256_and_ps(_mm256_cmp_ps(vdp, vt, _CMP_GT_OQ),
+                              _mm256_cmp_ps(d, vt_low, _CMP_GT_OQ)));
+            // the update: background_c + a (frame_c - background_c), a_fg where a candidate
+            const __m256 a = _mm256_blendv_ps(va_bg, va_fg, c);
+            _mm256_storeu_ps(ub + i, _mm256_add_ps(wb, _mm256_mul_ps(a, eb)));
+            _mm256_storeu_ps(ug + i, _mm256_add_ps(wg, _mm256_mul_ps(a, eg)));
+            _mm256_storeu_ps(ur + i, _mm256_add_ps(wr, _mm256_mul_ps(a, er)));
+            cf[half] = c;
+            ff[half][0] = vb;
+            ff[half][1] = vg;
+            ff[half][2] = vr;
+        }
+        if (_mm256_movemask_ps(_mm256_or_ps(cf[0], cf[1])) == 0) {
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(m + x), _mm_setzero_si128());
+            continue;
+        }
+        for (int half = 0; half < 2; ++half) {
+            const Index i = x + 8 * half;
+            _mm256_storeu_ps(fb + i, ff[half][0]);
+            _mm256_storeu_ps(fg + i, ff[half][1]);
+            _mm256_storeu_ps(fr + i, ff[half][2]);
+            _mm256_storeu_ps(cand + i, _mm256_and_ps(cf[half], one));
+        }
+        for (Index i = x; i < x + kCandidateChunk; ++i)
+            m[i] = mask_byte(cand[i] != 0.0f, fb[i], fg[i], fr[i], qb[i], qg[i], qr[i], sh);
+    }
+    return x;
+}
+#endif
+
 }  // namespace detail
 
 /// Adaptive background with the paper's selective update. The first frame (or `set_background`)
@@ -610,6 +744,13 @@ public:
         // that the differences' loop can write the update while the shadow test after it still
         // reads this frame's background.
         next_.resize(background_.size());
+        // the hand-written AVX2 row pass: only without bins (their pass reads the float planes
+        // of every pixel) and without a hold row (its update reads the candidate flags)
+        bool fused = false;
+#ifdef PFTRACK_LUT_GATHER
+        fused = bins == nullptr && hold == nullptr && __builtin_cpu_supports("avx2") &&
+                detail::avx2_allowed().load(std::memory_order_relaxed);
+#endif
         // Each row in three or four loops over L1-resident row buffers: (1), (2), (3) are
         // vectorised by the compiler (the shadow test of (2) too, over every pixel of each
         // 16-pixel chunk that has a candidate, skipped in the others: cheaper than branching
@@ -623,15 +764,31 @@ public:
             std::uint8_t* __restrict prev = previous_.data() + y * n3;  // planar, as qb
             std::int16_t* __restrict o = bins != nullptr ? bins + y * cols : nullptr;
             std::uint8_t* __restrict m = mask + y * cols;
+            // (1) + (2) without bins or hold row, where the CPU has AVX2: by hand, 16 pixels a
+            //     step, the frame's floats kept in registers; the row's last cols % 16 pixels
+            //     by the loops below
+            Index done = 0;
+#ifdef PFTRACK_LUT_GATHER
+            if (fused)
+                done = detail::background_row_fused_avx2(
+                    cols, px, prev, prev + cols, prev + 2 * cols, qb, qg, qr, t, t_low, sh, di, fb,
+                    fg, fr, cand, m, a_bg, a_fg, ub, ub + cols, ub + 2 * cols);
+#endif
+            if (done == cols) {
+                histogram_row(h8, di, cols);
+                continue;
+            }
             // (1) deinterleave into float planes, d_prev; I' <- I
-            detail::background_row_split(cols, px, prev, prev + cols, prev + 2 * cols, fb, fg, fr,
-                                         dprev);
+            detail::background_row_split(cols - done, px + 3 * done, prev + done,
+                                         prev + cols + done, prev + 2 * cols + done, fb + done,
+                                         fg + done, fr + done, dprev + done);
             // (2) per pixel: d_bg, candidates, mask, and (without a hold row) the selective
             //     update background_c + a (frame_c - background_c) into the next buffer
             if (hold == nullptr)
-                detail::background_row_candidates_update(cols, fb, fg, fr, qb, qg, qr, dprev, t,
-                                                         t_low, sh, di, cand, m, a_bg, a_fg, ub,
-                                                         ub + cols, ub + 2 * cols);
+                detail::background_row_candidates_update(
+                    cols - done, fb + done, fg + done, fr + done, qb + done, qg + done, qr + done,
+                    dprev + done, t, t_low, sh, di + done, cand + done, m + done, a_bg, a_fg,
+                    ub + done, ub + cols + done, ub + 2 * cols + done);
             else
                 detail::background_row_candidates(cols, fb, fg, fr, qb, qg, qr, dprev, t, t_low,
                                                   sh, di, cand, m);
@@ -641,12 +798,7 @@ public:
             if (o != nullptr)
                 for (Index x = 0; x < cols; ++x)
                     o[x] = static_cast<std::int16_t>(lut_.bin_at(si[x], hi[x]));
-            //     pixel x into copy x mod 8: eight at a time, each copy's address fixed (was
-            //     9 instructions a pixel, the copy's address computed from x; now about 2.4)
-            Index x = 0;
-            for (; x + 8 <= cols; x += 8)
-                for (size_t q = 0; q < 8; ++q) ++h8[q][static_cast<size_t>(di[x + static_cast<Index>(q)])];
-            for (; x < cols; ++x) ++h8[static_cast<size_t>(x & 7)][static_cast<size_t>(di[x])];
+            histogram_row(h8, di, cols);
             // (5) with a hold row, the selective update (a = 0 under the hold) into the next buffer
             if (hold != nullptr)
                 detail::background_row_update_held(cols, fb, fg, fr, qb, qg, qr, cand,
@@ -661,6 +813,18 @@ public:
         }
         threshold_ = next_threshold();
         ++frame_count_;
+    }
+
+    /// floor(d_bg) of a row's n pixels (`di`) counted into `h8`, pixel x into copy x mod 8:
+    /// eight at a time, each copy's address fixed (was 9 instructions a pixel, the copy's
+    /// address computed from x; now about 2.4).
+    static void histogram_row(std::array<std::array<std::int32_t, 256>, 8>& h8,
+                              const std::int32_t* di, Index n) {
+        Index x = 0;
+        for (; x + 8 <= n; x += 8)
+            for (size_t q = 0; q < 8; ++q)
+                ++h8[q][static_cast<size_t>(di[x + static_cast<Index>(q)])];
+        for (; x < n; ++x) ++h8[static_cast<size_t>(x & 7)][static_cast<size_t>(di[x])];
     }
 
     /// Everything a model has learnt (not its settings, not per-call scratch): what a pickled
@@ -890,17 +1054,25 @@ PFTRACK_VECTOR_CLONES static void mask_bins_row(const std::int16_t* __restrict s
         o[x] = static_cast<std::int16_t>(src[x] | -static_cast<std::int16_t>(m[x] == 0));
 }
 
+/// `mask_bins_row` in place: o[x] = -1 where m[x] is 0.
+PFTRACK_VECTOR_CLONES static void mask_bins_in_place(std::int16_t* __restrict o,
+                                                     const std::uint8_t* __restrict m, Index n) {
+    for (Index x = 0; x < n; ++x)
+        o[x] = static_cast<std::int16_t>(o[x] | -static_cast<std::int16_t>(m[x] == 0));
+}
+
 }  // namespace detail
 
 /// `HsvLut::bin` of every pixel of a BGR frame (rows x cols, `row_stride` bytes a row) into
 /// `out` (rows x cols, packed), -1 where `mask` (if not null, `mask_stride` bytes a row) is 0: a
 /// whole row by `HsvLut::bins_of_row` (AVX2), else the table indices of the row by the
 /// vectorised `hsv_row_indices`, then the look-ups (the same bins as `HsvLut::bin` pixel by
-/// pixel, several times faster). With a mask, only the masked
-/// pixels are binned, one by one: a foreground mask leaves most pixels out, and most rows empty
-/// (skipped eight bytes at a time). `out_stride` is in elements: the bins of one rectangle of a
-/// larger image (each pixel's bin depends on that pixel only, so any rectangle gets the bins the
-/// whole image would).
+/// pixel, several times faster). With a mask, only the 8-pixel groups that hold a masked pixel
+/// are binned: a foreground mask leaves most pixels out, and most rows empty (skipped 32, then
+/// 8 bytes at a time: `skip_zero_words`); each run of such groups by `bins_of_row`, then -1
+/// where the mask is 0 (without AVX2: the masked pixels one by one). `out_stride` is in
+/// elements: the bins of one rectangle of a larger image (each pixel's bin depends on that pixel
+/// only, so any rectangle gets the bins the whole image would).
 inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index rows, Index cols,
                            Index row_stride, const std::uint8_t* mask, Index mask_stride,
                            std::int16_t* out, Index out_stride) {
@@ -922,11 +1094,21 @@ inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index row
         std::fill(o, o + cols, std::int16_t(-1));
         Index x = 0;
         while (x < cols) {
+            x = detail::skip_zero_words(m, x, cols);  // most rows are background
             if (x + 8 <= cols) {
                 std::uint64_t word;
-                std::memcpy(&word, m + x, 8);
-                if (word == 0) {
-                    x += 8;
+                // a run of 8-pixel groups that each hold a masked pixel (a blob's row): binned
+                // whole by `bins_of_row` (AVX2: about 5 instructions a pixel, against 25 for
+                // one pixel's `bin`), then -1 where the mask is 0
+                Index end = x + 8;
+                while (end + 8 <= cols) {
+                    std::memcpy(&word, m + end, 8);
+                    if (word == 0) break;
+                    end += 8;
+                }
+                if (lut.bins_of_row(end - x, px + 3 * x, o + x)) {
+                    detail::mask_bins_in_place(o + x, m + x, end - x);
+                    x = end;
                     continue;
                 }
             }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "check.hpp"
+#include "mask_scan.hpp"
 #include "types.hpp"
 
 namespace pftrack {
@@ -339,12 +340,7 @@ inline std::vector<BlobRect> outer_regions(const std::uint8_t* mask, Index rows,
         Index x = 0;
         while (x < cols) {
             const Index s = x;
-            while (x + 8 <= cols) {  // background is most of a mask: 8 bytes at a time
-                std::uint64_t word;
-                std::memcpy(&word, p + x, 8);
-                if (word != 0) break;
-                x += 8;
-            }
+            x = detail::skip_zero_words(p, x, cols);  // background is most of a mask
             while (x < cols && p[x] == 0) ++x;
             if (x > s) {
                 bg.a.push_back(s);
