@@ -17,6 +17,7 @@ import tempfile
 import threading
 import time
 import traceback
+import warnings
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -394,6 +395,10 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         except ValueError as exc:
             render = None
             error = f"{exc} (pftrack render can draw {seq.name}.txt, which is written, into one)"
+    if frames.gap is not None and det is None and seq.gt is None:  # gt: refused below
+        from pftrack.io.video import gap_note
+
+        warnings.warn(gap_note(frames.gap), UserWarning, stacklevel=1)  # as pftrack track's
     run = track_path(
         frames,
         detections=det,

@@ -292,7 +292,7 @@ def run(args: argparse.Namespace) -> int:
         writes_through,
     )
     from pftrack.io.mot import format_mot_row, write_mot
-    from pftrack.io.video import FrameSource, check_source, is_live_source
+    from pftrack.io.video import FrameSource, check_source, gap_note, is_live_source
     from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size
     from pftrack.recovery import LinkConfig
     from pftrack.render import TrackRenderer, paths_title, plot_trajectories
@@ -367,6 +367,10 @@ def run(args: argparse.Namespace) -> int:
                     # after the run: a variable frame rate is said at frame 50 of an hour's video
                     stack.enter_context(warnings.catch_warnings())
                     warnings.simplefilter("always")
+                    if source.gap is not None and dets is None:  # with detections: refused
+                        # was said nowhere: the rows past the gap are numbered by position,
+                        # and a ground truth numbered by the names scored them shifted
+                        warnings.warn(gap_note(source.gap), UserWarning, stacklevel=1)
                     result = _track(
                         live,
                         first,

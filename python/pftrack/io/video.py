@@ -1287,6 +1287,21 @@ def _gap(folder: Path, images: list[Path]) -> str | None:
     return None
 
 
+def gap_note(gap: str) -> str:
+    """What a run without detections says of a folder whose names skip numbers (`gap`).
+
+    `gap` is :attr:`FrameSource.gap`. The rows number the frames by their position, as
+    :class:`FrameSource` does; a ground truth or detections numbered by the names (a camera's
+    dropped frames) do not line up with them past the gap. With detections the folder is
+    refused instead (:func:`pftrack.track_frames`).
+    """
+    return (
+        f"{gap}: the rows number the frames 1..N in the names' order (row frame k is the k-th "
+        "image), not by the names: a ground truth numbered by the names does not line up with "
+        "them past the gap"
+    )
+
+
 def _image_folder(path: Path, sequence: SequenceInfo | None) -> Path:
     """The folder whose images a folder source `path` (of `sequence`, if any) reads.
 
