@@ -522,9 +522,14 @@ def read_tracks(path: PathLike) -> F64:
     :func:`pftrack.recovery.linking.read_tracks`, which the one-file commands import without
     this package.
     """
+    from pftrack.io.mot import far_boxes_note
     from pftrack.recovery.linking import read_tracks as read
 
-    return read(path)
+    rows = read(path)
+    far = far_boxes_note(rows)
+    if far is not None:  # the task's warning, as pftrack recover FILE says it
+        warnings.warn(f"{path}: {far}", UserWarning, stacklevel=1)
+    return rows
 
 
 @dataclass(frozen=True)
