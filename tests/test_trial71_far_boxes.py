@@ -100,7 +100,7 @@ DATA = Path(os.environ.get("PFTRACK_DATA", Path(__file__).parents[1] / ".." / "s
 def test_the_datas_files_say_nothing() -> None:
     from pftrack.io.mot import far_boxes_note
 
-    files = sorted(DATA.glob("*/gt.txt")) + sorted(DATA.glob("*/det.txt"))
+    files = sorted(DATA.glob("**/gt.txt")) + sorted(DATA.glob("**/det.txt"))
     assert files
     for path in files:
         assert far_boxes_note(read_mot(path)) is None, path
