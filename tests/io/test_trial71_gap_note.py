@@ -45,9 +45,12 @@ def test_track_says_it_once_and_tracks_as_before(tmp_path: Path, capsys) -> None
     assert rows[:, 0].max() <= 10  # 10 images: frames numbered by position, as before
 
 
-def test_a_folder_numbered_without_a_gap_says_nothing(tmp_path: Path, capsys) -> None:
+@pytest.mark.parametrize("skip", [(), (2, 4, 6, 8, 10, 12)])
+def test_a_folder_numbered_without_a_hole_says_nothing(tmp_path: Path, capsys, skip) -> None:
+    """No gap, or names stepping evenly by 2 (every other frame kept: no frame count, as
+    tests/test_cli_io.py's time stamps and every fifth frame)."""
     folder = tmp_path / "imgs"
-    images(folder, skip=())
+    images(folder, skip=skip)
     assert main(["-q", "track", str(folder), "--out", str(tmp_path / "t.txt")]) == 0
     assert "skip numbers" not in capsys.readouterr().err
 

@@ -17,7 +17,6 @@ import tempfile
 import threading
 import time
 import traceback
-import warnings
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,6 +29,7 @@ from pftrack._check import brief, flag, instance, number, option, shown
 from pftrack._text import error_line
 from pftrack._threads import tracking_threads
 from pftrack._typing import F64, BenchmarkName, FillMode, PathLike, RecoveryMethod
+from pftrack._warn import warn
 from pftrack.batch.inputs import SequenceInput
 
 if TYPE_CHECKING:  # importing pftrack.tracking loads the whole tracker; recover needs none of it
@@ -395,10 +395,12 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         except ValueError as exc:
             render = None
             error = f"{exc} (pftrack render can draw {seq.name}.txt, which is written, into one)"
-    if frames.gap is not None and det is None and seq.gt is None:  # gt: refused below
+    if det is None and seq.gt is None:  # with detections or a ground truth: refused
         from pftrack.io.video import gap_note
 
-        warnings.warn(gap_note(frames.gap), UserWarning, stacklevel=1)  # as pftrack track's
+        gap = gap_note(frames)
+        if gap is not None:
+            warn(gap)  # the sequence's warning, as pftrack track says it
     run = track_path(
         frames,
         detections=det,
@@ -528,7 +530,7 @@ def read_tracks(path: PathLike) -> F64:
     rows = read(path)
     far = far_boxes_note(rows)
     if far is not None:  # the task's warning, as pftrack recover FILE says it
-        warnings.warn(f"{path}: {far}", UserWarning, stacklevel=1)
+        warn(f"{path}: {far}")
     return rows
 
 

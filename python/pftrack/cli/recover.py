@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import os
 import time
-import warnings
 from pathlib import Path
 from typing import Any
 
+from pftrack._warn import warn
 from pftrack.cli import batch
 from pftrack.cli._options import (
     TRACKS_YOURS,
@@ -109,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
     rows = read_tracks(src)
     far = far_boxes_note(rows)
     if far is not None:  # was: carried along the tracks without a word
-        warnings.warn(f"{src}: {far}", UserWarning, stacklevel=1)
+        warn(f"{src}: {far}")
     n_links = 0
     if args.link:
         frames = None

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import argparse
 import os
-import warnings
 from pathlib import Path
 from typing import Any
 
+from pftrack._warn import warn
 from pftrack.cli import batch
 from pftrack.cli._options import (
     TRACKS_YOURS,
@@ -75,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     rows = read_tracks(src)
     far = far_boxes_note(rows)
     if far is not None:  # was: carried along the tracks without a word
-        warnings.warn(f"{src}: {far}", UserWarning, stacklevel=1)
+        warn(f"{src}: {far}")
     link = None if args.no_link else link_config_for(rows, args.max_gap, args.max_distance)
     result = smooth_tracks(rows, link=link, max_gap=args.max_gap)
     # the work is done: --out is written whatever comes (as in recover; after a Ctrl-C

@@ -10,6 +10,7 @@ import warnings
 from pathlib import Path
 from typing import IO, Any
 
+from pftrack._warn import warn
 from pftrack.cli._options import (
     DET_SCALE_RANGE,
     FPS_RANGE,
@@ -367,10 +368,11 @@ def run(args: argparse.Namespace) -> int:
                     # after the run: a variable frame rate is said at frame 50 of an hour's video
                     stack.enter_context(warnings.catch_warnings())
                     warnings.simplefilter("always")
-                    if source.gap is not None and dets is None:  # with detections: refused
+                    gap = gap_note(source) if dets is None else None  # with them: refused
+                    if gap is not None:
                         # was said nowhere: the rows past the gap are numbered by position,
                         # and a ground truth numbered by the names scored them shifted
-                        warnings.warn(gap_note(source.gap), UserWarning, stacklevel=1)
+                        warn(gap)
                     result = _track(
                         live,
                         first,
