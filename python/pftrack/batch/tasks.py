@@ -29,6 +29,7 @@ from pftrack._check import brief, flag, instance, number, option, shown
 from pftrack._text import error_line
 from pftrack._threads import tracking_threads
 from pftrack._typing import F64, BenchmarkName, FillMode, PathLike, RecoveryMethod
+from pftrack._warn import warn
 from pftrack.batch.inputs import SequenceInput
 
 if TYPE_CHECKING:  # importing pftrack.tracking loads the whole tracker; recover needs none of it
@@ -394,6 +395,12 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         except ValueError as exc:
             render = None
             error = f"{exc} (pftrack render can draw {seq.name}.txt, which is written, into one)"
+    if det is None and seq.gt is None:  # with detections or a ground truth: refused
+        from pftrack.io.video import gap_note
+
+        gap = gap_note(frames)
+        if gap is not None:
+            warn(gap)  # the sequence's warning, as pftrack track says it
     run = track_path(
         frames,
         detections=det,
@@ -517,9 +524,14 @@ def read_tracks(path: PathLike) -> F64:
     :func:`pftrack.recovery.linking.read_tracks`, which the one-file commands import without
     this package.
     """
+    from pftrack.io.mot import far_boxes_note
     from pftrack.recovery.linking import read_tracks as read
 
-    return read(path)
+    rows = read(path)
+    far = far_boxes_note(rows)
+    if far is not None:  # the task's warning, as pftrack recover FILE says it
+        warn(f"{path}: {far}")
+    return rows
 
 
 @dataclass(frozen=True)

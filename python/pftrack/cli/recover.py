@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from pftrack._warn import warn
 from pftrack.cli import batch
 from pftrack.cli._options import (
     TRACKS_YOURS,
@@ -82,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
     args.tracks = args.tracks[0]
     from pftrack.cli._signals import hold_interrupts
     from pftrack.io.atomic import check_output, check_replaceable
-    from pftrack.io.mot import is_mot_text, write_mot
+    from pftrack.io.mot import far_boxes_note, is_mot_text, write_mot
     from pftrack.recovery import fill_gaps, link_tracklets
     from pftrack.recovery.fill import copied_values, unfilled_note
     from pftrack.recovery.linking import link_config_for, read_tracks
@@ -106,6 +107,9 @@ def run(args: argparse.Namespace) -> int:
 
         check_outside_frames({"--out": args.out}, args.video)
     rows = read_tracks(src)
+    far = far_boxes_note(rows)
+    if far is not None:  # was: carried along the tracks without a word
+        warn(f"{src}: {far}")
     n_links = 0
     if args.link:
         frames = None

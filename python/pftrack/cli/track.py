@@ -10,6 +10,7 @@ import warnings
 from pathlib import Path
 from typing import IO, Any
 
+from pftrack._warn import warn
 from pftrack.cli._options import (
     DET_SCALE_RANGE,
     FPS_RANGE,
@@ -292,7 +293,7 @@ def run(args: argparse.Namespace) -> int:
         writes_through,
     )
     from pftrack.io.mot import format_mot_row, write_mot
-    from pftrack.io.video import FrameSource, check_source, is_live_source
+    from pftrack.io.video import FrameSource, check_source, gap_note, is_live_source
     from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size
     from pftrack.recovery import LinkConfig
     from pftrack.render import TrackRenderer, paths_title, plot_trajectories
@@ -367,6 +368,11 @@ def run(args: argparse.Namespace) -> int:
                     # after the run: a variable frame rate is said at frame 50 of an hour's video
                     stack.enter_context(warnings.catch_warnings())
                     warnings.simplefilter("always")
+                    gap = gap_note(source) if dets is None else None  # with them: refused
+                    if gap is not None:
+                        # was said nowhere: the rows past the gap are numbered by position,
+                        # and a ground truth numbered by the names scored them shifted
+                        warn(gap)
                     result = _track(
                         live,
                         first,

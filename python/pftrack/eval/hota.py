@@ -25,6 +25,7 @@ from pftrack.eval.rows import (  # the scored rows; here too, as before
     mot_iou,
     not_parts_message,
     prepare_mot,
+    say_none_matched,
 )
 from pftrack.io.mot import ID, LEFT, group_by_frame
 
@@ -217,7 +218,7 @@ def _empty(num_gt: int, num_res: int) -> HotaMetrics:
     )
 
 
-def evaluate_hota(
+def hota_scores(
     gt: ArrayLike,
     result: ArrayLike,
     *,
@@ -226,42 +227,9 @@ def evaluate_hota(
     num_frames: int | None = None,
     on_progress: Report | None = None,
 ) -> HotaMetrics:
-    """HOTA, DetA, AssA, LocA and their recall/precision parts of one sequence.
+    """:func:`evaluate_hota`'s scores, without its warning of a result that matched nothing.
 
-    Parameters
-    ----------
-    gt, result : (M, 6..10) array_like of float
-        Ground-truth and result MOT rows, as read by :func:`pftrack.io.mot.read_mot`.
-    benchmark : {"auto", "MOT15", "MOT16", "MOT17", "MOT20"}
-        Passed to :func:`prepare_mot`; ``"auto"`` (the default, as :func:`evaluate_sequence`)
-        guesses MOT15 or MOT17 from the columns (:func:`guess_benchmark`; ``pftrack eval``
-        first takes the benchmark a TrackEval folder names, ``MOT20-train``).
-    scale, num_frames
-        Passed to :func:`prepare_mot`, which chooses the rows that are scored.
-    on_progress : callable, optional
-        Called now and then as ``on_progress(f)``, `f` the fraction of the work done (from 0
-        to 1, ending with 1), as the frames are scored: ``pftrack eval``'s bar.
-
-    Returns
-    -------
-    HotaMetrics
-
-    Notes
-    -----
-    Similarity is :func:`mot_iou`. First, over the whole sequence, every (gt id, result id)
-    pair accumulates ``sum_t IoU_t / (rowsum + colsum - IoU_t)`` (its soft match count), giving a
-    global alignment score ``A = count / (n_gt + n_res - count)``. Then, in each frame, boxes are
-    matched by the Hungarian algorithm maximising ``A * IoU``; for each threshold alpha a match
-    with ``IoU >= alpha`` is a TP. AssA at alpha is the TP-weighted mean over matched pairs of
-    ``TPA / (TPA + FNA + FPA)`` (TPA: frames the pair is matched; FNA, FPA: the rest of the
-    gt's and the result track's boxes). Everything is TrackEval 1.3.0's arithmetic, vectorised
-    over thresholds.
-
-    References
-    ----------
-    .. [1] Luiten, J. et al. (2021). HOTA: a higher order metric for evaluating multi-object
-       tracking. International Journal of Computer Vision 129, 548-578.
-    .. [2] Luiten, J. & Hoffhues, A. (2020). TrackEval. (``trackeval.metrics.HOTA``)
+    :func:`~pftrack.eval.evaluate_sequence` scores with it and says that warning once itself.
     """
     check_report(on_progress, "evaluate_hota")
     option(benchmark, "evaluate_hota: benchmark", ("auto", *BENCHMARKS))
@@ -351,6 +319,72 @@ def evaluate_hota(
         ass_pr=ass_pr,
         loc_a=np.maximum(1e-10, loc_sum) / np.maximum(1e-10, tp),
     )
+
+
+def evaluate_hota(
+    gt: ArrayLike,
+    result: ArrayLike,
+    *,
+    benchmark: BenchmarkName = "auto",
+    scale: float = 1.0,
+    num_frames: int | None = None,
+    on_progress: Report | None = None,
+) -> HotaMetrics:
+    """HOTA, DetA, AssA, LocA and their recall/precision parts of one sequence.
+
+    Parameters
+    ----------
+    gt, result : (M, 6..10) array_like of float
+        Ground-truth and result MOT rows, as read by :func:`pftrack.io.mot.read_mot`.
+    benchmark : {"auto", "MOT15", "MOT16", "MOT17", "MOT20"}
+        Passed to :func:`prepare_mot`; ``"auto"`` (the default, as :func:`evaluate_sequence`)
+        guesses MOT15 or MOT17 from the columns (:func:`guess_benchmark`; ``pftrack eval``
+        first takes the benchmark a TrackEval folder names, ``MOT20-train``).
+    scale, num_frames
+        Passed to :func:`prepare_mot`, which chooses the rows that are scored.
+    on_progress : callable, optional
+        Called now and then as ``on_progress(f)``, `f` the fraction of the work done (from 0
+        to 1, ending with 1), as the frames are scored: ``pftrack eval``'s bar.
+
+    Returns
+    -------
+    HotaMetrics
+
+    Warns
+    -----
+    UserWarning
+        A result of some rows none of whose boxes matches a scored ground-truth box at any
+        threshold (IoU 0.05 or more; HOTA 0): frames numbered otherwise, or another sequence's
+        tracks, as :func:`evaluate_mot` says at its `iou_threshold`. The scores are returned
+        as computed. An empty result says nothing.
+
+    Notes
+    -----
+    Similarity is :func:`mot_iou`. First, over the whole sequence, every (gt id, result id)
+    pair accumulates ``sum_t IoU_t / (rowsum + colsum - IoU_t)`` (its soft match count), giving a
+    global alignment score ``A = count / (n_gt + n_res - count)``. Then, in each frame, boxes are
+    matched by the Hungarian algorithm maximising ``A * IoU``; for each threshold alpha a match
+    with ``IoU >= alpha`` is a TP. AssA at alpha is the TP-weighted mean over matched pairs of
+    ``TPA / (TPA + FNA + FPA)`` (TPA: frames the pair is matched; FNA, FPA: the rest of the
+    gt's and the result track's boxes). Everything is TrackEval 1.3.0's arithmetic, vectorised
+    over thresholds.
+
+    References
+    ----------
+    .. [1] Luiten, J. et al. (2021). HOTA: a higher order metric for evaluating multi-object
+       tracking. International Journal of Computer Vision 129, 548-578.
+    .. [2] Luiten, J. & Hoffhues, A. (2020). TrackEval. (``trackeval.metrics.HOTA``)
+    """
+    h = hota_scores(
+        gt, result, benchmark=benchmark, scale=scale, num_frames=num_frames,
+        on_progress=on_progress,
+    )  # fmt: skip
+    # matched nothing at the lowest threshold: at none (was: HOTA 0 without a word)
+    say_none_matched(
+        "evaluate_hota", gt, result, truth=int(h.tp[0] + h.fn[0]), matches=int(h.tp[0]),
+        iou_threshold=float(ALPHAS[0]), scored=f"HOTA {h.hota:.3f}",
+    )  # fmt: skip
+    return h
 
 
 def combine_hota(parts: Iterable[HotaMetrics] | Sequence[HotaMetrics]) -> HotaMetrics:

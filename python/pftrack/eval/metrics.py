@@ -28,6 +28,7 @@ from pftrack.eval.rows import (
     guess_benchmark,
     not_parts_message,
     prepare_mot,
+    say_none_matched,
 )
 from pftrack.io.mot import FRAME, ID, LEFT
 
@@ -337,7 +338,7 @@ def _identity_tp(
     return total
 
 
-def evaluate_mot(
+def clear_scores(
     gt: ArrayLike,
     result: ArrayLike,
     *,
@@ -348,65 +349,9 @@ def evaluate_mot(
     num_frames: int | None = None,
     on_progress: Report | None = None,
 ) -> MotMetrics:
-    """Score a tracking result against ground truth.
+    """:func:`evaluate_mot`'s scores, without its warning of a result that matched nothing.
 
-    Parameters
-    ----------
-    gt : (M, 6..10) array_like of float
-        Ground truth MOT rows. Rows with ``conf == 0`` are not scored (see Notes).
-    result : (R, 6..10) array_like of float
-        Result MOT rows (one id per track; ``conf`` is ignored).
-    iou_threshold : float
-        A result box can match a ground-truth box when their IoU is >= this, in (0, 1].
-    scale : float
-        Multiplies the ground-truth boxes (left, top, width, height) before scoring, e.g. 0.625
-        for PETS09 ground truth (768x576) against a tracker run on the 480x360 video.
-    image_size : (width, height), optional
-        Image size for the centroid-distance ratio (NaN without it): two finite numbers > 0.
-    benchmark : {"auto", "MOT15", "MOT16", "MOT17", "MOT20"}
-        Which MOTChallenge rules choose the scored rows (:func:`pftrack.eval.prepare_mot`);
-        ``"auto"`` guesses MOT15 or MOT17 from the columns (:func:`pftrack.eval.guess_benchmark`).
-    num_frames : int, optional
-        The sequence length (``seqLength``); a row in a later frame is an error.
-    on_progress : callable, optional
-        Called now and then as ``on_progress(f)``, `f` the fraction of the work done (from 0
-        to 1, ending with 1), as the frames are scored: ``pftrack eval``'s bar.
-
-    Returns
-    -------
-    MotMetrics
-
-    Notes
-    -----
-    Per-frame matching is TrackEval's ``CLEAR`` (the MOTChallenge server's): in each frame
-    holding both ground-truth and result boxes, one Hungarian assignment maximises, over the
-    pairs whose IoU reaches `iou_threshold` (less ``eps``, 2.2e-16, as TrackEval), 1000 for each
-    pair that goes on from the last such frame (the object was matched to that result id there)
-    plus the pair's IoU: a track goes on where it can, and IoU decides the rest. Exact ties go
-    by the order of the rows in the frame, as TrackEval reads them from the file. A match to a
-    different id than the object's last match, however long ago, is an identity switch.
-    (py-motmetrics differs: it keeps a match after any gap and pairs the rest separately, for
-    the most matches: below an `iou_threshold` of 0.5 the largest IoU sum can be fewer.)
-    Identity (IDF1) counts the frames where a pair's IoU is >= `iou_threshold`, as TrackEval's
-    ``Identity``.
-
-    The rows scored are those HOTA scores, chosen by TrackEval's MOTChallenge preprocessing
-    (:func:`pftrack.eval.prepare_mot`): ground-truth rows whose ``conf`` (the "consider" flag)
-    truncates to 0 are left out; for MOT16/17/20 also other classes than pedestrian, and result
-    boxes matched to a distractor (a static person, a reflection, ...). Under MOT15 rules a
-    result box on a left-out ground-truth box stays, as a false positive. The figures are
-    TrackEval's ``CLEAR`` and ``Identity`` on the same files
-    (``tests/eval/test_hota.py``); IDF1, IDP and IDR are py-motmetrics' too on the rows scored
-    (its CLEAR-MOT differs in five details: ``docs/eval.md``).
-
-    References
-    ----------
-    .. [1] Bernardin, K. & Stiefelhagen, R. (2008). Evaluating multiple object tracking
-       performance: the CLEAR MOT metrics. EURASIP J. Image and Video Processing.
-    .. [2] Ristani, E. et al. (2016). Performance measures and a data set for multi-target,
-       multi-camera tracking. ECCV workshops.
-    .. [3] Smith, K., Gatica-Perez, D., Odobez, J.-M. & Ba, S. (2005). Evaluating multi-object
-       tracking. CVPR workshop on empirical evaluation methods in computer vision.
+    :func:`~pftrack.eval.evaluate_sequence` scores with it and says that warning once itself.
     """
     iou_threshold = number(iou_threshold, "evaluate_mot: iou_threshold", finite=False)
     if not (math.isfinite(iou_threshold) and 0.0 < iou_threshold <= 1.0):
@@ -599,6 +544,98 @@ def evaluate_mot(
         iou_threshold=float(iou_threshold),
         scale=float(scale),
     )
+
+
+def evaluate_mot(
+    gt: ArrayLike,
+    result: ArrayLike,
+    *,
+    iou_threshold: float = 0.5,
+    scale: float = 1.0,
+    image_size: tuple[int, int] | None = None,
+    benchmark: BenchmarkName = "auto",
+    num_frames: int | None = None,
+    on_progress: Report | None = None,
+) -> MotMetrics:
+    """Score a tracking result against ground truth.
+
+    Parameters
+    ----------
+    gt : (M, 6..10) array_like of float
+        Ground truth MOT rows. Rows with ``conf == 0`` are not scored (see Notes).
+    result : (R, 6..10) array_like of float
+        Result MOT rows (one id per track; ``conf`` is ignored).
+    iou_threshold : float
+        A result box can match a ground-truth box when their IoU is >= this, in (0, 1].
+    scale : float
+        Multiplies the ground-truth boxes (left, top, width, height) before scoring, e.g. 0.625
+        for PETS09 ground truth (768x576) against a tracker run on the 480x360 video.
+    image_size : (width, height), optional
+        Image size for the centroid-distance ratio (NaN without it): two finite numbers > 0.
+    benchmark : {"auto", "MOT15", "MOT16", "MOT17", "MOT20"}
+        Which MOTChallenge rules choose the scored rows (:func:`pftrack.eval.prepare_mot`);
+        ``"auto"`` guesses MOT15 or MOT17 from the columns (:func:`pftrack.eval.guess_benchmark`).
+    num_frames : int, optional
+        The sequence length (``seqLength``); a row in a later frame is an error.
+    on_progress : callable, optional
+        Called now and then as ``on_progress(f)``, `f` the fraction of the work done (from 0
+        to 1, ending with 1), as the frames are scored: ``pftrack eval``'s bar.
+
+    Returns
+    -------
+    MotMetrics
+
+    Warns
+    -----
+    UserWarning
+        A result of some rows none of whose boxes matches a scored ground-truth box at
+        `iou_threshold` (MOTA at or below 0): frames numbered otherwise, or another sequence's
+        tracks. The warning names the two spans of frames; the scores are returned as
+        computed. An empty result says nothing.
+
+    Notes
+    -----
+    Per-frame matching is TrackEval's ``CLEAR`` (the MOTChallenge server's): in each frame
+    holding both ground-truth and result boxes, one Hungarian assignment maximises, over the
+    pairs whose IoU reaches `iou_threshold` (less ``eps``, 2.2e-16, as TrackEval), 1000 for each
+    pair that goes on from the last such frame (the object was matched to that result id there)
+    plus the pair's IoU: a track goes on where it can, and IoU decides the rest. Exact ties go
+    by the order of the rows in the frame, as TrackEval reads them from the file. A match to a
+    different id than the object's last match, however long ago, is an identity switch.
+    (py-motmetrics differs: it keeps a match after any gap and pairs the rest separately, for
+    the most matches: below an `iou_threshold` of 0.5 the largest IoU sum can be fewer.)
+    Identity (IDF1) counts the frames where a pair's IoU is >= `iou_threshold`, as TrackEval's
+    ``Identity``.
+
+    The rows scored are those HOTA scores, chosen by TrackEval's MOTChallenge preprocessing
+    (:func:`pftrack.eval.prepare_mot`): ground-truth rows whose ``conf`` (the "consider" flag)
+    truncates to 0 are left out; for MOT16/17/20 also other classes than pedestrian, and result
+    boxes matched to a distractor (a static person, a reflection, ...). Under MOT15 rules a
+    result box on a left-out ground-truth box stays, as a false positive. The figures are
+    TrackEval's ``CLEAR`` and ``Identity`` on the same files
+    (``tests/eval/test_hota.py``); IDF1, IDP and IDR are py-motmetrics' too on the rows scored
+    (its CLEAR-MOT differs in five details: ``docs/eval.md``).
+
+    References
+    ----------
+    .. [1] Bernardin, K. & Stiefelhagen, R. (2008). Evaluating multiple object tracking
+       performance: the CLEAR MOT metrics. EURASIP J. Image and Video Processing.
+    .. [2] Ristani, E. et al. (2016). Performance measures and a data set for multi-target,
+       multi-camera tracking. ECCV workshops.
+    .. [3] Smith, K., Gatica-Perez, D., Odobez, J.-M. & Ba, S. (2005). Evaluating multi-object
+       tracking. CVPR workshop on empirical evaluation methods in computer vision.
+    """
+    m = clear_scores(
+        gt, result, iou_threshold=iou_threshold, scale=scale, image_size=image_size,
+        benchmark=benchmark, num_frames=num_frames, on_progress=on_progress,
+    )  # fmt: skip
+    # was: MOTA -1.0 without a word for results numbered from frame 101 against a truth of
+    # frames 1-71 (evaluate_sequence and pftrack eval said it)
+    say_none_matched(
+        "evaluate_mot", gt, result, truth=m.num_objects, matches=m.num_matches,
+        iou_threshold=m.iou_threshold, scored=f"MOTA {m.mota:.3f}",
+    )  # fmt: skip
+    return m
 
 
 def combine_mot(parts: Sequence[MotMetrics]) -> MotMetrics:

@@ -26,11 +26,15 @@ from pftrack._check import (
     path_refused,
     real_array,
 )
+from pftrack._warn import warn
 from pftrack.boxes import _box_rows
 from pftrack.io.mot import CONF, FRAME, ID, LEFT, group_by_frame
 
 __all__ = [
     "BENCHMARKS",
+    "NONE_MATCHED",
+    "none_matched",
+    "say_none_matched",
     "check_eval_rows",
     "check_unique_ids",
     "guess_benchmark",
@@ -395,3 +399,79 @@ def prepare_mot(
     if not keep_g:
         return np.zeros((0, 10)), np.zeros((0, 10))
     return np.concatenate(keep_g), np.concatenate(keep_r)
+
+
+#: What :func:`~pftrack.eval.evaluate_sequence`'s warning of a result that matched nothing
+#: begins with: a caller that says it otherwise filters it by this (``pftrack eval`` names the
+#: files, once its outputs are written).
+NONE_MATCHED = "evaluate_sequence: none of the result's "
+#: How that warning names the result.
+RESULTS = "the result's"
+
+
+def _span(frames: NDArray[np.float64]) -> str:
+    """``frame F`` or ``frames F-L`` of a column of frame numbers."""
+    first, last = int(frames.min()), int(frames.max())
+    return f"frame {first}" if first == last else f"frames {first}-{last}"
+
+
+def none_matched(
+    result: NDArray[np.float64],
+    gt: NDArray[np.float64],
+    iou_threshold: float,
+    *,
+    whose: str,
+    gt_name: str = "",
+) -> str:
+    """Why a non-empty `result` none of whose boxes matched a box of `gt` looks mistaken.
+
+    Almost always a pair of rows that do not belong together: the tracks of another sequence
+    or video, or frames numbered otherwise. When no frame of the result is a frame of the
+    ground truth, that is said instead (the frames' numbering, not the boxes, is at fault).
+    `whose` names the result's boxes (``"the result's"``; ``"its"`` after a file's name),
+    `gt_name` the ground truth's file, if any.
+    """
+    n = len(result)
+    of = f" of {gt_name}" if gt_name else ""
+    disjoint = not np.isin(result[:, FRAME], gt[:, FRAME]).any()
+    why = (
+        "no frame of it is a frame of the ground truth: frames numbered otherwise (shifted?), "
+        "or the tracks of another sequence?"
+        if disjoint
+        else "the tracks of another sequence or video, or frames numbered otherwise?"
+    )
+    return (
+        f"none of {whose} {n} box{'es' * (n != 1)} ({_span(result[:, FRAME])}) matches a "
+        f"ground-truth box{of} ({_span(gt[:, FRAME])}) with IoU {iou_threshold:g} or more, on "
+        f"any frame: {why}"
+    )
+
+
+def say_none_matched(
+    fn: str,
+    gt: ArrayLike,
+    result: ArrayLike,
+    *,
+    truth: int,
+    matches: int,
+    iou_threshold: float,
+    scored: str,
+) -> None:
+    """Warn, from the caller of `fn`, when a non-empty `result` matched no scored truth box.
+
+    The one rule of :func:`~pftrack.eval.evaluate_mot`, :func:`~pftrack.eval.evaluate_hota`
+    and :func:`~pftrack.eval.evaluate_sequence` (which says it once, for CLEAR-MOT): `truth`
+    ground-truth boxes were scored and `matches` of them matched at `iou_threshold`; `scored`
+    is the figure returned as computed (``"MOTA -1.000"``). An empty result is a finding (the
+    tracker found nothing), not a mix-up, and says nothing; so does a truth with nothing
+    scored. `gt` and `result` are the caller's rows, already accepted by
+    :func:`check_eval_rows`: read again only when the warning is given.
+    """
+    if not truth or matches:
+        return
+    res = check_eval_rows(result, f"{fn}: result")
+    if not len(res):
+        return
+    said = none_matched(res, check_eval_rows(gt, f"{fn}: gt"), iou_threshold, whose=RESULTS)
+    # stacklevel 3: warn's caller is this function, then `fn`, then the line that called it
+    warn(f"{fn}: {said} (scored as given: {scored})", UserWarning, stacklevel=3)

@@ -28,10 +28,17 @@ from numpy.typing import ArrayLike, NDArray
 from pftrack._check import NORMALISED_REACH, option
 from pftrack._progress import Report, check_report, part
 from pftrack._typing import BenchmarkName, PathLike
-from pftrack._warn import warn
-from pftrack.eval.hota import HotaMetrics, combine_hota, evaluate_hota, guess_benchmark
-from pftrack.eval.metrics import MotMetrics, check_image_size, combine_mot, evaluate_mot
-from pftrack.eval.rows import BENCHMARKS, _mot_iou, check_eval_rows, not_parts_message
+from pftrack.eval.hota import HotaMetrics, combine_hota, guess_benchmark, hota_scores
+from pftrack.eval.metrics import MotMetrics, check_image_size, clear_scores, combine_mot
+from pftrack.eval.rows import (
+    BENCHMARKS,
+    _mot_iou,
+    check_eval_rows,
+    not_parts_message,
+    say_none_matched,
+)
+from pftrack.eval.rows import NONE_MATCHED as NONE_MATCHED  # pftrack eval's filter, from here
+from pftrack.eval.rows import none_matched as none_matched  # pftrack eval's note, from here
 from pftrack.io.mot import CONF, FRAME, HEIGHT, LEFT, TOP, WIDTH
 
 __all__ = [
@@ -585,71 +592,20 @@ def evaluate_sequence(
     gt = check_eval_rows(gt, "evaluate_sequence: gt")
     result = check_eval_rows(result, "evaluate_sequence: result")
     mark = guess_benchmark(gt) if benchmark == "auto" else benchmark
-    h = evaluate_hota(
+    # the scorers' unsaid forms: the one warning below is CLEAR-MOT's, this function's name
+    h = hota_scores(
         gt, result, benchmark=mark, scale=scale, num_frames=num_frames,
         on_progress=part(on_progress, 0.0, HOTA_SHARE),
     )  # fmt: skip
-    m = evaluate_mot(
+    m = clear_scores(
         gt, result, iou_threshold=iou_threshold, scale=scale, image_size=image_size,
         benchmark=mark, num_frames=num_frames, on_progress=part(on_progress, HOTA_SHARE, 1.0),
     )  # fmt: skip
-    if len(result) and m.num_objects and not m.num_matches:
-        # as pftrack eval says it (was: MOTA -1.0 without a word for results numbered from
-        # frame 101 against a truth of frames 1-71); an empty result is a finding, not a mix-up
-        warn(
-            "evaluate_sequence: "
-            f"{none_matched(result, gt, iou_threshold, whose=RESULTS)} (scored as given: "
-            f"MOTA {m.mota:.3f})",
-            UserWarning,
-            stacklevel=2,
-        )
+    say_none_matched(  # one warning, CLEAR-MOT's (as pftrack eval says it)
+        "evaluate_sequence", gt, result, truth=m.num_objects, matches=m.num_matches,
+        iou_threshold=iou_threshold, scored=f"MOTA {m.mota:.3f}",
+    )  # fmt: skip
     return SequenceScores(mot=m, hota=h, benchmark=mark)
-
-
-#: What :func:`evaluate_sequence`'s warning of a result that matched nothing begins with: a
-#: caller that says it otherwise filters it by this (``pftrack eval`` names the files, once its
-#: outputs are written).
-NONE_MATCHED = "evaluate_sequence: none of the result's "
-#: How that warning names the result.
-RESULTS = "the result's"
-
-
-def _span(frames: NDArray[np.float64]) -> str:
-    """``frame F`` or ``frames F-L`` of a column of frame numbers."""
-    first, last = int(frames.min()), int(frames.max())
-    return f"frame {first}" if first == last else f"frames {first}-{last}"
-
-
-def none_matched(
-    result: NDArray[np.float64],
-    gt: NDArray[np.float64],
-    iou_threshold: float,
-    *,
-    whose: str,
-    gt_name: str = "",
-) -> str:
-    """Why a non-empty `result` none of whose boxes matched a box of `gt` looks mistaken.
-
-    Almost always a pair of rows that do not belong together: the tracks of another sequence
-    or video, or frames numbered otherwise. When no frame of the result is a frame of the
-    ground truth, that is said instead (the frames' numbering, not the boxes, is at fault).
-    `whose` names the result's boxes (``"the result's"``; ``"its"`` after a file's name),
-    `gt_name` the ground truth's file, if any.
-    """
-    n = len(result)
-    of = f" of {gt_name}" if gt_name else ""
-    disjoint = not np.isin(result[:, FRAME], gt[:, FRAME]).any()
-    why = (
-        "no frame of it is a frame of the ground truth: frames numbered otherwise (shifted?), "
-        "or the tracks of another sequence?"
-        if disjoint
-        else "the tracks of another sequence or video, or frames numbered otherwise?"
-    )
-    return (
-        f"none of {whose} {n} box{'es' * (n != 1)} ({_span(result[:, FRAME])}) matches a "
-        f"ground-truth box{of} ({_span(gt[:, FRAME])}) with IoU {iou_threshold:g} or more, on "
-        f"any frame: {why}"
-    )
 
 
 def _pct(x: float) -> str:

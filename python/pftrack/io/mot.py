@@ -32,6 +32,7 @@ from pftrack._check import (
     path_arg,
     shown,
 )
+from pftrack._stats import median, percentile
 from pftrack._typing import F64, PathLike
 from pftrack._warn import warn
 from pftrack.io.atomic import atomic_write, refuse_dash, refuse_loop
@@ -774,6 +775,47 @@ def write_mot(
     text = _lines(a, mask)
     with atomic_write(path) as fh:
         fh.write(text)
+
+
+#: How far a box's centre may lie from the median of a file's box centres, in multiples of
+#: their spread (the interquartile range, or the median box size when larger), before
+#: :func:`far_boxes_note` says it: at 100, a 1920-pixel frame's tracks would need a box 50 000
+#: px or more away, no camera's pixels (stop 71's trial: a tracker's boxes at x = 1e7).
+FAR_SPREAD = 100.0
+
+
+def far_boxes_note(rows: NDArray[np.float64]) -> str | None:
+    """What to say of tracks rows whose boxes lie far from where the others lie, or None.
+
+    Another tracker's diverged boxes (``1e+07`` among boxes of a 480-pixel frame) pass every
+    check of :func:`read_mot` (values up to ±1e9 px), and filling and smoothing carry them
+    along their tracks: a smoothed track took rows at x = -50 to x = 2e6. A row is far when
+    its box's centre is more than :data:`FAR_SPREAD` times the rows' spread from their
+    median centre, on either axis (quartiles: a quarter of the rows may be far and still be
+    found). Fewer than 4 rows are not judged.
+    """
+    if len(rows) < 4:
+        return None
+    far = np.zeros(len(rows), dtype=bool)
+    within: list[str] = []
+    for left, size in ((LEFT, WIDTH), (TOP, HEIGHT)):
+        centre = rows[:, left] + rows[:, size] / 2
+        # pftrack._stats': np.percentile and np.median import numpy.ma (15-20 ms of CPU)
+        q1, mid, q3 = (percentile(centre, q) for q in (25, 50, 75))
+        spread = max(q3 - q1, median(rows[:, size]), 1.0)
+        far |= np.abs(centre - mid) > FAR_SPREAD * spread
+        within.append(f"{q1:.0f}..{q3:.0f}")
+    if not far.any():
+        return None
+    n, k = int(far.sum()), int(np.flatnonzero(far)[0])
+    r = rows[k]
+    return (
+        f"{n} row{'s' * (n != 1)} with a box {FAR_SPREAD:g} times the others' spread or more "
+        f"from them (the first: frame {r[FRAME]:.0f}, id {r[ID]:.0f}, left {r[LEFT]:g}, top "
+        f"{r[TOP]:g}, {r[WIDTH]:g}x{r[HEIGHT]:g}; half the centres lie within x {within[0]}, "
+        f"y {within[1]}): a tracker's diverged boxes, or values in other units? Filling and "
+        "smoothing carry them along their tracks: mend or drop them first"
+    )
 
 
 def group_by_frame(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:

@@ -1287,6 +1287,32 @@ def _gap(folder: Path, images: list[Path]) -> str | None:
     return None
 
 
+def gap_note(source: FrameSource) -> str | None:
+    """What a run without detections says of `source`'s numbering, or None.
+
+    Said of an image folder whose names count frames one by one with holes (``0001.png ..
+    0030.png`` without ``0011``: a camera's or a cut's dropped frames; most steps between
+    consecutive names are 1): its rows number the frames by position, as :class:`FrameSource`
+    does, and a ground truth numbered by the names does not line up with them past the hole.
+    Names that step evenly by more (``1.png, 6.png, 11.png``; millisecond time stamps) number
+    no frames and say nothing. With detections a folder with a gap is refused instead
+    (:func:`pftrack.track_frames`).
+    """
+    if source.gap is None or source._images is None:
+        return None
+    numbered = _numbered([p.stem for p in source._images])
+    if numbered is None:
+        return None
+    steps = np.diff([int(text) for text in numbered[1]])
+    if np.count_nonzero(steps == 1) * 2 <= len(steps):  # most steps are not 1: no frame count
+        return None
+    return (
+        f"{source.gap}: the rows number the frames 1..N in the names' order (row frame k is the "
+        "k-th image), not by the names: a ground truth numbered by the names does not line up "
+        "with them past the gap"
+    )
+
+
 def _image_folder(path: Path, sequence: SequenceInfo | None) -> Path:
     """The folder whose images a folder source `path` (of `sequence`, if any) reads.
 
