@@ -72,10 +72,13 @@ def _reference(r: np.ndarray, holes: np.ndarray) -> np.ndarray:
     file_speed = float(np.quantile(steps, STEP_QUANTILE))
     out = []
     for e in holes:
-        own = 0.0
+        own, seen = 0.0, False
         for i in range(e - OWN_STEPS, e + OWN_STEPS + 1):
             if i != e and 0 <= i < len(r) - 1 and consecutive(i) and r[i, 1] == r[e, 1]:
-                own = max(own, step(i))
+                own, seen = max(own, step(i)), True
+        if not seen:  # no speed of its own: not judged
+            out.append(0.0)
+            continue
         scale = max(0.5 * (size[e] + size[e + 1]), 1.0)
         speed = max(own, file_speed, 1.0 / scale)
         out.append(step(e) / ((r[e + 1, 0] - r[e, 0]) * speed))
@@ -131,11 +134,20 @@ def test_jump_holes_matches_a_plain_reference() -> None:
     assert jump_holes(r, holes[:0]).shape == (0,)
 
 
-def test_nothing_judged_without_a_step_between_consecutive_frames() -> None:
+def test_nothing_judged_without_a_track_speed() -> None:
     rows = np.array([[1, 1, 0, 0, 10, 10], [5, 1, 900, 900, 10, 10]], dtype=np.float64)
     r, holes = _holes(rows)
     assert jump_holes(r, holes).tolist() == [0.0]
     assert fill_gaps(rows)[1].n_jumps == 0  # no speed to judge by: filled, as it was
+    # among tracks seen on every frame, a track seen only twice has no speed of its own:
+    # not judged by the others' (a detector run every few frames), and filled
+    walkers = [[f, k, 10.0 * k + f, 50.0, 20.0, 40.0] for k in (1, 2) for f in range(1, 11)]
+    sparse = [[1, 3, 100, 100, 20, 40], [5, 3, 300, 200, 20, 40]]
+    _, report = fill_gaps(np.array(walkers + sparse, dtype=np.float64))
+    assert (report.n_gaps, report.n_jumps) == (1, 0)
+    seen = sparse + [[f, 3, 300, 200, 20, 40] for f in (6, 7)]  # now still after the hole
+    _, report = fill_gaps(np.array(walkers + seen, dtype=np.float64))
+    assert (report.n_gaps, report.n_jumps) == (0, 1)
 
 
 def test_a_static_file_still_lets_a_box_move_a_pixel_a_frame() -> None:

@@ -251,7 +251,9 @@ def jump_holes(r: F64, holes: NDArray[np.int64]) -> F64:
     between them times a speed: the largest of the track's own :data:`OWN_STEPS`
     frame-to-frame steps on each side of the hole, the file's :data:`STEP_QUANTILE` quantile of
     every track's frame-to-frame steps (its robust speed scale: camera motion and fast classes
-    raise it) and 1 px a frame. :func:`fill_gaps` leaves a hole of more than
+    raise it) and 1 px a frame. A hole of a track with no two rows on consecutive frames
+    among the :data:`OWN_STEPS` steps on each side is not judged (0). :func:`fill_gaps`
+    leaves a hole of more than
     :data:`JUMP_FACTOR` unfilled: its sides are two objects under one id, and a filled path
     would join them (issue 12: a tracker that hands its ids on; was filled without a word).
 
@@ -265,8 +267,8 @@ def jump_holes(r: F64, holes: NDArray[np.int64]) -> F64:
     Returns
     -------
     (H,) ndarray of float
-        Each hole's jump over the distance allowed (0 without a file speed: no step between
-        consecutive frames anywhere in `r`, where nothing can be judged).
+        Each hole's jump over the distance allowed (0 where nothing can be judged: no step
+        between consecutive frames near the hole, or anywhere in `r`).
     """
     if not len(holes):
         return np.zeros(0)
@@ -292,6 +294,9 @@ def jump_holes(r: F64, holes: NDArray[np.int64]) -> F64:
     speed = np.maximum(np.maximum(own, file_speed), 1.0 / scale)  # at least 1 px a frame
     frames = r[holes + 1, 0] - r[holes, 0]
     out: F64 = step[holes] / (frames * speed)
+    # a track seen on no two consecutive frames near the hole has no speed of its own: the
+    # file's alone would judge a sparse track (a detector run every few frames) by others
+    out[~mine.any(axis=1)] = 0.0
     return out
 
 
