@@ -79,8 +79,8 @@ BLOCK_METHODS = ("gdt", "gdt-bi", "gdt-mix", "gdt-fixed", "rts")
 #: A hole is left unfilled when its two sides are farther apart than this many times the
 #: distance the object could have moved over it (:func:`jump_holes`): two objects under one id
 #: (a tracker that hands an id on). The real holes of eight ground truths (41 851, the masks of
-#: ``pftrack experiment gaps`` and a fifth of rows dropped) reach at most 1.84 times; 4 leaves
-#: a margin of 2.2 (docs/recovery.md, "A hole between two objects is left").
+#: ``pftrack experiment gaps`` and a fifth of rows dropped) reach at most 1.87 times; 4 leaves
+#: a margin of 2.1 (docs/recovery.md, "A hole between two objects is left").
 JUMP_FACTOR = 4.0
 #: The quantile of the file's frame-to-frame steps (in box sizes) any track may move at: the
 #: file's own robust speed scale, so a camera that moves, a frame rate or a class of fast
@@ -252,10 +252,10 @@ def jump_holes(r: F64, holes: NDArray[np.int64]) -> F64:
     frame-to-frame steps on each side of the hole, the file's :data:`STEP_QUANTILE` quantile of
     every track's frame-to-frame steps (its robust speed scale: camera motion and fast classes
     raise it) and 1 px a frame. A hole of a track with no two rows on consecutive frames
-    among the :data:`OWN_STEPS` steps on each side is not judged (0). :func:`fill_gaps`
-    leaves a hole of more than
-    :data:`JUMP_FACTOR` unfilled: its sides are two objects under one id, and a filled path
-    would join them (issue 12: a tracker that hands its ids on; was filled without a word).
+    among the :data:`OWN_STEPS` steps on each side is not judged (0). :func:`fill_gaps` leaves
+    a hole of more than :data:`JUMP_FACTOR` unfilled: its sides are two objects under one id,
+    and a filled path would join them (issue 12: a tracker that hands its ids on; was filled
+    without a word).
 
     Parameters
     ----------
