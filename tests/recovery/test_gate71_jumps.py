@@ -19,6 +19,7 @@ from pftrack.io.mot import read_mot, write_mot
 from pftrack.recovery import fill_gaps
 from pftrack.recovery.fill import (
     JUMP_FACTOR,
+    MIN_SPEED,
     OWN_STEPS,
     STEP_QUANTILE,
     jump_holes,
@@ -80,7 +81,7 @@ def _reference(r: np.ndarray, holes: np.ndarray) -> np.ndarray:
             out.append(0.0)
             continue
         scale = max(0.5 * (size[e] + size[e + 1]), 1.0)
-        speed = max(own, file_speed, 1.0 / scale)
+        speed = max(own, file_speed, MIN_SPEED, 1.0 / scale)
         out.append(step(e) / ((r[e + 1, 0] - r[e, 0]) * speed))
     return np.array(out)
 
@@ -150,11 +151,19 @@ def test_nothing_judged_without_a_track_speed() -> None:
     assert (report.n_gaps, report.n_jumps) == (0, 1)
 
 
-def test_a_static_file_still_lets_a_box_move_a_pixel_a_frame() -> None:
+def test_a_static_file_still_lets_a_box_move() -> None:
+    """Nothing moves in the file: 1 px a frame for small boxes, MIN_SPEED box sizes for large."""
     still = [[f, 1, 10.0, 10.0, 4.0, 4.0] for f in range(1, 20)]
     moved = [[f, 2, 50.0 + (f > 10) * 3.0, 50.0, 4.0, 4.0] for f in [*range(1, 10), *range(12, 20)]]
     _, report = fill_gaps(np.array(still + moved))
     assert (report.n_gaps, report.n_jumps) == (1, 0)  # 3 px over 3 frames: within 1 px a frame
+    far = [[f, 2, 50.0 + (f > 10) * 30.0, 50.0, 4.0, 4.0] for f in [*range(1, 10), *range(12, 20)]]
+    assert fill_gaps(np.array(still + far))[1].n_jumps == 1  # 30 px over 3 frames of 4 px boxes
+    # boxes of 40 px: 4 x 3 frames x MIN_SPEED x 40 px = 24 px allowed, at 20 px filled
+    big = [
+        [f, 3, 50.0 + (f > 10) * 20.0, 50.0, 40.0, 40.0] for f in [*range(1, 10), *range(12, 20)]
+    ]
+    assert fill_gaps(np.array(still + big))[1].n_jumps == 0
 
 
 def test_fast_people_of_a_car_mounted_camera_are_not_refused() -> None:

@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _check
 from pftrack._check import MAX_COORD
+from pftrack._stats import percentile
 from pftrack._text import counted
 from pftrack._typing import F64, IntLike, RecoveryMethod
 from pftrack.recovery import calibrate
@@ -88,6 +89,10 @@ JUMP_FACTOR = 4.0
 STEP_QUANTILE = 0.9
 #: Frame-to-frame steps on each side of a hole that give the track's own speed.
 OWN_STEPS = 5
+#: The least speed any object may have moved at over a hole, in box sizes a frame (and at
+#: least 1 px a frame): where nothing in the file moves (no speed scale of its own), a person
+#: who stood still on both sides may have walked across the hole.
+MIN_SPEED = 0.05
 
 
 @dataclass(frozen=True)
@@ -251,11 +256,11 @@ def jump_holes(r: F64, holes: NDArray[np.int64]) -> F64:
     between them times a speed: the largest of the track's own :data:`OWN_STEPS`
     frame-to-frame steps on each side of the hole, the file's :data:`STEP_QUANTILE` quantile of
     every track's frame-to-frame steps (its robust speed scale: camera motion and fast classes
-    raise it) and 1 px a frame. A hole of a track with no two rows on consecutive frames
-    among the :data:`OWN_STEPS` steps on each side is not judged (0). :func:`fill_gaps` leaves
-    a hole of more than :data:`JUMP_FACTOR` unfilled: its sides are two objects under one id,
-    and a filled path would join them (issue 12: a tracker that hands its ids on; was filled
-    without a word).
+    raise it) and :data:`MIN_SPEED` (or 1 px a frame, the more). A hole of a track with no two
+    rows on consecutive frames among the :data:`OWN_STEPS` steps on each side is not judged
+    (0). :func:`fill_gaps` leaves a hole of more than :data:`JUMP_FACTOR` unfilled: its sides
+    are two objects under one id, and a filled path would join them (issue 12: a tracker that
+    hands its ids on; was filled without a word).
 
     Parameters
     ----------
@@ -281,7 +286,7 @@ def jump_holes(r: F64, holes: NDArray[np.int64]) -> F64:
     consecutive = same & (r[1:, 0] - r[:-1, 0] == 1)
     if not consecutive.any():
         return np.zeros(len(holes))
-    file_speed = float(np.quantile(step[consecutive], STEP_QUANTILE))
+    file_speed = percentile(step[consecutive], 100 * STEP_QUANTILE)  # np.quantile's, no numpy.ma
     # the track's own steps: the pairs within OWN_STEPS of the hole, of consecutive frames of
     # its id (other holes and other ids left out)
     offsets = np.r_[np.arange(-OWN_STEPS, 0), np.arange(1, OWN_STEPS + 1)]
@@ -291,7 +296,7 @@ def jump_holes(r: F64, holes: NDArray[np.int64]) -> F64:
     mine = inside & consecutive[at] & (r[at, 1] == r[holes, 1][:, None])
     own = np.where(mine, step[at], 0.0).max(axis=1)
     scale = np.maximum(pair[holes], 1.0)
-    speed = np.maximum(np.maximum(own, file_speed), 1.0 / scale)  # at least 1 px a frame
+    speed = np.maximum(np.maximum(own, file_speed), np.maximum(MIN_SPEED, 1.0 / scale))
     frames = r[holes + 1, 0] - r[holes, 0]
     out: F64 = step[holes] / (frames * speed)
     # a track seen on no two consecutive frames near the hole has no speed of its own: the
