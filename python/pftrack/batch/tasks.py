@@ -602,6 +602,7 @@ def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
         "filled_rows": rep.n_filled_rows,
         "long_holes": rep.n_long_holes,  # longer than max_gap: left unfilled
         "longest_hole": rep.longest_hole,
+        "jump_holes": rep.n_jumps,  # two objects under one id: left unfilled (issue 12)
         "rows_out": len(filled),
         "seconds": time.perf_counter() - t0,
         "explain": rep.describe(),
@@ -639,7 +640,7 @@ class SmoothOptions:
 
 def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
     """Link, fill and smooth one tracks file as ``pftrack smooth FILE`` does."""
-    from pftrack.recovery.fill import long_holes
+    from pftrack.recovery.fill import long_holes, short_holes
     from pftrack.recovery.linking import link_config_for
     from pftrack.tracking import smooth_tracks
     from pftrack.tracking.offline import smoothed_copies
@@ -658,6 +659,7 @@ def smooth_file(path: Path, options: SmoothOptions) -> TaskResult:
         "rows_out": len(result),
         "long_holes": n_long,  # longer than max_gap: left unfilled
         "longest_hole": longest,
+        "jump_holes": short_holes(result, options.max_gap),  # the others were filled: issue 12
         "seconds": time.perf_counter() - t0,
     }
     return TaskResult(result, {}, info, exact=smoothed_copies(result))

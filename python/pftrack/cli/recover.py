@@ -85,7 +85,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.atomic import check_output, check_replaceable
     from pftrack.io.mot import far_boxes_note, is_mot_text, write_mot
     from pftrack.recovery import fill_gaps, link_tracklets
-    from pftrack.recovery.fill import copied_values, unfilled_note
+    from pftrack.recovery.fill import copied_values, jump_note, unfilled_note
     from pftrack.recovery.linking import link_config_for, read_tracks
 
     src = Path(args.tracks)
@@ -143,6 +143,8 @@ def run(args: argparse.Namespace) -> int:
     )
     if rep.n_long_holes:  # bounded work, said: was silent ("0 gaps filled")
         print(f"{src}: {unfilled_note(rep.n_long_holes, rep.longest_hole, args.max_gap)}", file=to)
+    if rep.n_jumps:  # was filled without a word: a path drawn between two objects (issue 12)
+        warn(f"{src}: {jump_note(rep.n_jumps, rep.largest_jump)}")
     if args.explain:
         print(rep.describe(), file=to)
     return 0

@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.cli.recover import flag_note
     from pftrack.io.atomic import check_output, check_replaceable
     from pftrack.io.mot import far_boxes_note, is_mot_text, write_mot
-    from pftrack.recovery.fill import long_holes, unfilled_note
+    from pftrack.recovery.fill import jump_note, long_holes, short_holes, unfilled_note
     from pftrack.recovery.linking import link_config_for, read_tracks
     from pftrack.tracking import smooth_tracks
     from pftrack.tracking.offline import smoothed_copies
@@ -93,4 +93,7 @@ def run(args: argparse.Namespace) -> int:
     n_long, longest = long_holes(result, args.max_gap)  # every shorter hole was filled
     if n_long:  # bounded work, said: was silent
         print(f"{src}: {unfilled_note(n_long, longest, args.max_gap)}", file=to)
+    n_jumps = short_holes(result, args.max_gap)  # every other shorter hole was filled
+    if n_jumps:  # was filled without a word: a path drawn between two objects (issue 12)
+        warn(f"{src}: {jump_note(n_jumps, 0.0)}")
     return 0

@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _check
 from pftrack._check import MAX_COORD
+from pftrack._stats import percentile
 from pftrack._text import counted
 from pftrack._typing import F64, IntLike, RecoveryMethod
 from pftrack.recovery import calibrate
@@ -52,7 +53,10 @@ __all__ = [
     "copied_values",
     "fill_gaps",
     "fill_rows",
+    "jump_holes",
+    "jump_note",
     "long_holes",
+    "short_holes",
     "unfilled_note",
 ]
 
@@ -73,6 +77,22 @@ WHOLE_SEGMENT_METHODS = ("gsi",)
 #: 39 830 holes). The ``"-nb"`` methods go by the same blocks, with one neighbourhood for the
 #: file (``registry._recover_nb``).
 BLOCK_METHODS = ("gdt", "gdt-bi", "gdt-mix", "gdt-fixed", "rts")
+#: A hole is left unfilled when its two sides are farther apart than this many times the
+#: distance the object could have moved over it (:func:`jump_holes`): two objects under one id
+#: (a tracker that hands an id on). The real holes of eight ground truths (41 851, the masks of
+#: ``pftrack experiment gaps`` and a fifth of rows dropped) reach at most 1.87 times; 4 leaves
+#: a margin of 2.1 (docs/recovery.md, "A hole between two objects is left").
+JUMP_FACTOR = 4.0
+#: The quantile of the file's frame-to-frame steps (in box sizes) any track may move at: the
+#: file's own robust speed scale, so a camera that moves, a frame rate or a class of fast
+#: objects raises it for the whole file.
+STEP_QUANTILE = 0.9
+#: Frame-to-frame steps on each side of a hole that give the track's own speed.
+OWN_STEPS = 5
+#: The least speed any object may have moved at over a hole, in box sizes a frame (and at
+#: least 1 px a frame): where nothing in the file moves (no speed scale of its own), a person
+#: who stood still on both sides may have walked across the hole.
+MIN_SPEED = 0.05
 
 
 @dataclass(frozen=True)
@@ -88,7 +108,10 @@ class FillReport:
     :data:`SIZE_CANDIDATES`); ``n_long_holes``: the holes of more than ``max_gap`` missing
     frames, left unfilled (bounded work), and ``longest_hole`` the missing frames of the
     longest of them (0 without one; :func:`long_holes`, :func:`unfilled_note`); ``method``:
-    the method of the fill (:meth:`describe` tells what it chose).
+    the method of the fill (:meth:`describe` tells what it chose); ``n_jumps``: the holes of
+    at most ``max_gap`` frames left unfilled because their two sides are too far apart to be
+    one object (:func:`jump_holes`), and ``largest_jump`` the largest of their jumps, in
+    times the distance allowed (0 without one; :func:`jump_note`).
     """
 
     n_gaps: int
@@ -99,6 +122,8 @@ class FillReport:
     n_long_holes: int = 0
     longest_hole: int = 0
     method: RecoveryMethod = DEFAULT_METHOD
+    n_jumps: int = 0
+    largest_jump: float = 0.0
 
     def __str__(self) -> str:
         """What ``print(report)`` shows: the counts, then :meth:`describe` (``repr``: fields).
@@ -111,6 +136,8 @@ class FillReport:
                 f"; {counted(self.n_long_holes, 'hole')} longer than max_gap left unfilled "
                 f"(the longest {counted(self.longest_hole, 'frame')})"
             )
+        if self.n_jumps:
+            filled += f"; {jump_note(self.n_jumps, self.largest_jump)}"
         return f"fill_gaps ({self.method}): {filled}\n{self.describe()}"
 
     def describe(self, method: str | None = None) -> str:
@@ -160,6 +187,8 @@ class FillReport:
                 f"{self.method}: {gaps} filled by the method given, nothing was chosen (auto "
                 "chooses a method per gap length)"
             )
+        if self.n_jumps:  # was filled: a path drawn between two objects (issue 12)
+            parts.append(jump_note(self.n_jumps, self.largest_jump))
         return "\n".join(parts)
 
 
@@ -202,6 +231,96 @@ def unfilled_note(count: int, longest: int, max_gap: int) -> str:
         return ""
     holes, longest_ = ("1 hole", "") if count == 1 else (f"{count} holes", "longest ")
     return f"{holes} longer than --max-gap {max_gap} left unfilled ({longest_}{longest} frames)"
+
+
+def short_holes(rows: F64, max_gap: int) -> int:
+    """How many holes of at most `max_gap` missing frames the ids' tracks of `rows` have.
+
+    Of the output of :func:`fill_gaps` or :func:`pftrack.tracking.smooth_tracks` with the same
+    `max_gap`, these are the holes :func:`jump_holes` left (every other one is filled): what
+    ``pftrack smooth`` counts, as its fill's report is not returned.
+    """
+    a = np.asarray(rows, dtype=np.float64)
+    if len(a) < 2:
+        return 0
+    a = a[np.lexsort((a[:, 0], a[:, 1]))]  # by id, then frame
+    missing = np.diff(a[:, 0]) - 1
+    return int(np.count_nonzero((a[1:, 1] == a[:-1, 1]) & (missing >= 1) & (missing <= max_gap)))
+
+
+def jump_holes(r: F64, holes: NDArray[np.int64]) -> F64:
+    """How far each hole's two sides are apart, in times the distance its object could move.
+
+    The jump is the distance between the box centres on the two sides of the hole, in box
+    sizes (the mean of the two boxes' ``(w + h) / 2``); the distance allowed is the frames
+    between them times a speed: the largest of the track's own :data:`OWN_STEPS`
+    frame-to-frame steps on each side of the hole, the file's :data:`STEP_QUANTILE` quantile of
+    every track's frame-to-frame steps (its robust speed scale: camera motion and fast classes
+    raise it) and :data:`MIN_SPEED` (or 1 px a frame, the more). A hole of a track with no two
+    rows on consecutive frames among the :data:`OWN_STEPS` steps on each side is not judged
+    (0). :func:`fill_gaps` leaves a hole of more than :data:`JUMP_FACTOR` unfilled: its sides
+    are two objects under one id, and a filled path would join them (issue 12: a tracker that
+    hands its ids on; was filled without a word).
+
+    Parameters
+    ----------
+    r : (M, >=6) ndarray
+        Rows ``frame, id, left, top, width, height, ...`` sorted by id, then frame.
+    holes : (H,) ndarray of int
+        Rows of `r` followed by a later frame of the same id (the last row before each hole).
+
+    Returns
+    -------
+    (H,) ndarray of float
+        Each hole's jump over the distance allowed (0 where nothing can be judged: no step
+        between consecutive frames near the hole, or anywhere in `r`).
+    """
+    if not len(holes):
+        return np.zeros(0)
+    size = 0.5 * (r[:, 4] + r[:, 5])  # a box 0 wide still has a size
+    pair = 0.5 * (size[1:] + size[:-1])
+    # jump of every pair of neighbouring rows, in box sizes (a 0 x 0 box: in pixels)
+    step = np.hypot(*(r[1:, 2:4] + 0.5 * r[1:, 4:6] - r[:-1, 2:4] - 0.5 * r[:-1, 4:6]).T)
+    step = step / np.maximum(pair, 1.0)
+    same = r[1:, 1] == r[:-1, 1]
+    consecutive = same & (r[1:, 0] - r[:-1, 0] == 1)
+    if not consecutive.any():
+        return np.zeros(len(holes))
+    file_speed = percentile(step[consecutive], 100 * STEP_QUANTILE)  # np.quantile's, no numpy.ma
+    # the track's own steps: the pairs within OWN_STEPS of the hole, of consecutive frames of
+    # its id (other holes and other ids left out)
+    offsets = np.r_[np.arange(-OWN_STEPS, 0), np.arange(1, OWN_STEPS + 1)]
+    at = holes[:, None] + offsets[None, :]
+    inside = (at >= 0) & (at < len(step))
+    at = np.clip(at, 0, len(step) - 1)
+    mine = inside & consecutive[at] & (r[at, 1] == r[holes, 1][:, None])
+    own = np.where(mine, step[at], 0.0).max(axis=1)
+    scale = np.maximum(pair[holes], 1.0)
+    speed = np.maximum(np.maximum(own, file_speed), np.maximum(MIN_SPEED, 1.0 / scale))
+    frames = r[holes + 1, 0] - r[holes, 0]
+    out: F64 = step[holes] / (frames * speed)
+    # a track seen on no two consecutive frames near the hole has no speed of its own: the
+    # file's alone would judge a sparse track (a detector run every few frames) by others
+    out[~mine.any(axis=1)] = 0.0
+    return out
+
+
+def jump_note(count: int, largest: float) -> str:
+    """What `recover`, `smooth` and the report say of the holes :func:`jump_holes` left.
+
+    ``"2 holes left unfilled: their two sides are too far apart for one object (up to 9.3
+    times the distance it could move; two objects under one id?)"``; empty when `count` is 0.
+    """
+    if not count:
+        return ""
+    holes = "1 hole" if count == 1 else f"{count} holes"
+    its = "its" if count == 1 else "their"
+    up = "" if count == 1 or largest <= 0 else "up to "
+    times = f"{up}{largest:.1f} times the distance it could move; " if largest > 0 else ""
+    return (
+        f"{holes} left unfilled: {its} two sides are too far apart for one object "
+        f"({times}two objects under one id?)"
+    )
 
 
 #: The methods whose recovery uses :func:`fill_gaps`' `noise`.
@@ -346,7 +465,13 @@ def fill_rows(
         not len(c) or np.abs(c[:, 1:3]).max() <= MAX_COORD
     )
     lo, hi = (win.lo, win.hi) if cut else (win.first, win.end)
-    keep = ~too_long
+    # two objects under one id (issue 12): judged on the holes short enough to fill only
+    jump = np.zeros(len(win.holes))
+    jump[~too_long] = jump_holes(r, win.holes[~too_long])
+    jumps = jump > JUMP_FACTOR
+    n_jumps = int(jumps.sum())
+    largest_jump = float(jump[jumps].max()) if n_jumps else 0.0
+    keep = ~too_long & ~jumps
     holes, lo, hi = win.holes[keep], lo[keep], hi[keep]
     segs = _HolePairs(seg, holes, lo, hi)  # made a block at a time as recover_auto reads them
     before = (holes + 1 - win.first[keep]).tolist()  # observed points before each hole
@@ -413,7 +538,16 @@ def fill_rows(
             new_rows.append(out)
     added = np.vstack(new_rows) if new_rows else np.zeros((0, 10))
     return added, FillReport(
-        len(segs), len(added), noise, calibration, size_cal, n_long, longest, method
+        len(segs),
+        len(added),
+        noise,
+        calibration,
+        size_cal,
+        n_long,
+        longest,
+        method,
+        n_jumps,
+        largest_jump,
     )
 
 
