@@ -237,8 +237,8 @@ def mask_bins(binned: BinnedImage, mask: NDArray[Any]) -> BinnedImage: ...  # ma
 def sampled_mean(frame: NDArray[np.uint8], step: int) -> float: ...
 
 # testing hook: whether background.hpp's hand-written AVX2 passes may run (BackgroundModel.apply's
-# row pass, hsv_bins' rows; the portable loops otherwise, the same results); returns the previous
-# setting, process-wide
+# row pass, hsv_bins' rows, clean_mask / open_mask / close_mask's bit planes; the portable loops
+# otherwise, the same results); returns the previous setting, process-wide
 def _set_avx2(allowed: bool) -> bool: ...
 
 # closing of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are single runs,

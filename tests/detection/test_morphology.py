@@ -1,5 +1,5 @@
-"""The mask's closing in C++ (pftrack._core.close_mask) against the NumPy reference
-(tests/reference/detection.py) and cv2.morphologyEx, bit for bit."""
+"""The mask's closing and opening in C++ (pftrack._core.close_mask, open_mask, clean_mask)
+against the NumPy reference (tests/reference/detection.py) and cv2.morphologyEx, bit for bit."""
 
 from __future__ import annotations
 
@@ -140,11 +140,11 @@ def test_close_and_open_mask_refuse_bad_input(fn) -> None:
 # --- the packed path (stop 71): masks of 0 and at most two levels, 255 the upper, as bit planes
 
 
-@pytest.fixture(params=[True, False], ids=["sse2", "portable"])
+@pytest.fixture(params=[True, False], ids=["avx2", "portable"])
 def simd_packing(request: pytest.FixtureRequest):
-    """Whether the packed path packs bytes with SSE2 or 8 at a time in 64-bit words (the portable
-    fallback other CPUs run): `_core._set_avx2` turns both hand-written paths off. Each test runs
-    twice; both are held to OpenCV."""
+    """Whether the packed path takes its AVX2 pack, passes and unpack or the portable loops
+    (bytes 8 at a time in 64-bit words) other CPUs run: `_core._set_avx2` turns AVX2 off. Each
+    test runs twice; both are held to OpenCV."""
     before = _core._set_avx2(request.param)
     yield request.param
     _core._set_avx2(before)

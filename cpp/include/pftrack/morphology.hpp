@@ -268,7 +268,7 @@ template <int NS, bool Dilate>
 __attribute__((target("avx2"))) inline void shifted_avx2(const std::uint8_t* src,
                                                          std::uint64_t* out, Index n,
                                                          const Index* q, const int* r, int ns) {
-    constexpr int kMax = 8;
+    constexpr int kMax = 8;  // callers pass at most 8 shifts (runs up to 8 wide; doubling's 2)
     const int cnt = NS > 0 ? NS : ns;
     const Index n4 = n / 4 * 4;
     __m128i ca[kMax], cb[kMax];
@@ -505,9 +505,9 @@ struct PackedPass {
 /// bytes a row), each as `morphology`, when src holds at most two non-zero values one of which,
 /// if two, is 255 (0 and 255; 0 and m; 0, m and 255): the same bytes as the byte path. Returns
 /// false, writing nothing, for any other mask or an element without its anchor pixel (the caller
-/// then takes the byte path). With `simd`
-/// (and SSE2) bytes are packed 16 at a time; else 8 at a time in 64-bit words (the portable
-/// fallback, the same bits). `dst` must not alias `src`.
+/// then takes the byte path). With `simd`, on a CPU with AVX2, bytes are packed and unpacked 32 at
+/// a time and the passes take 4 words a step (`*_avx2`); else the portable loops (bytes 8 at a
+/// time in 64-bit words, a table per 8 pixels): the same bits. `dst` must not alias `src`.
 inline bool clean_packed(const std::uint8_t* src, Index src_stride, std::uint8_t* dst, Index rows,
                          Index cols, const std::vector<PackedPass>& passes, bool simd,
                          PackedScratch& s) {
