@@ -216,3 +216,41 @@ def test_theil_sen_core(benchmark: BenchmarkFixture, size_samples: Any) -> None:
 def test_theil_sen_numpy(benchmark: BenchmarkFixture, size_samples: Any) -> None:
     benchmark.group = "Theil-Sen line, 200 samples"
     benchmark(theil_sen_reference, *size_samples)
+
+
+@pytest.fixture(scope="module")
+def raw_masks(frames: Frames) -> tuple[str, list[NDArray[np.uint8]], Any]:
+    """The raw masks with shadows (0/127/255) of the 60 frames (primed detector), and the
+    detector's (opening, closing) elements for this size."""
+    from pftrack.detection.base import BlobConfig, BlobExtractor
+
+    name, fr = frames
+    det: Any = make_detector("paper")
+    det.prime(fr[::2])
+    masks: list[NDArray[np.uint8]] = []
+    clean = det._blobs.clean  # recorded as `detect` cleans each frame's raw mask
+    det._blobs.clean = lambda raw: (masks.append(raw.copy()), clean(raw))[1]
+    for f in fr:
+        det.detect(f)
+    return name, masks, BlobExtractor(BlobConfig())._elements(fr[0].shape[0])
+
+
+@pytest.mark.parametrize("path", ["packed", "bytes", "opencv"])
+def test_clean_mask(benchmark: BenchmarkFixture, raw_masks: Any, path: str) -> None:
+    """The opening and closing of a raw mask: bit planes (0/127/255), the byte path (the same
+    masks with one pixel of a third level, 200), and OpenCV's two morphologyEx calls."""
+    name, masks, (k_open, k_close) = raw_masks
+    benchmark.group = f"clean mask {name}"
+    if path == "bytes":
+        masks = [m.copy() for m in masks]
+        for m in masks:
+            m[0, 0] = 200  # a third non-zero level: not two planes
+    if path == "opencv":
+
+        def run(m: NDArray[np.uint8]) -> Any:
+            opened = cv2.morphologyEx(m, cv2.MORPH_OPEN, k_open)
+            return cv2.morphologyEx(opened, cv2.MORPH_CLOSE, k_close)
+
+        benchmark(cycle_apply(run, masks))
+    else:
+        benchmark(cycle_apply(lambda m: _core.clean_mask(m, k_open, k_close), masks))

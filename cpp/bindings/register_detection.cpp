@@ -62,31 +62,47 @@ std::vector<ElementRow> to_element(const py::array& k, const char* fn) {
     return element_rows(static_cast<const std::uint8_t*>(k.data()), k.shape(0), k.shape(1), fn);
 }
 
-/// The signature of close_mask and open_mask (morphology.hpp): two passes through `tmp`.
-using MaskPass = void (*)(const std::uint8_t*, Index, std::uint8_t*, std::uint8_t*, Index, Index,
-                          const std::vector<ElementRow>&, MorphScratch&);
-
-/// `pass` of a (H, W) uint8/bool mask by a structuring element, checked, into a new mask.
-py::array_t<std::uint8_t> mask_pass(const py::object& mask_in, const py::object& element_in,
-                                    const char* fn, MaskPass pass) {
+/// `passes` of a (H, W) uint8/bool mask, checked, into a new mask: the packed path
+/// (morphology.hpp `clean_packed`) for a mask of two levels or three with 255, else the byte
+/// path (`morphology`, pass after pass through a scratch mask).
+py::array_t<std::uint8_t> mask_passes(const py::object& mask_in,
+                                      const std::vector<std::pair<py::object, MorphOp>>& given,
+                                      const char* fn) {
     const py::array mask = bind::mask_array(mask_in, fn);
-    const py::array element = bind::mask_array(element_in, fn, "element", "(kh, kw)");
+    std::vector<std::vector<ElementRow>> elements;
+    for (const auto& [element_in, op] : given) {
+        const py::array element = bind::mask_array(element_in, fn, "element", "(kh, kw)");
+        elements.push_back(to_element(element, fn));
+    }
     if (!(mask.ndim() == 2 && mask.shape(0) > 0 && mask.shape(1) > 0))
         fail(fn, "mask must be a non-empty (H, W) array");
     bind::check_mask(mask, mask.shape(0), mask.shape(1), fn);
-    const std::vector<ElementRow> el = to_element(element, fn);
+    std::vector<PackedPass> passes;
+    for (size_t i = 0; i < given.size(); ++i) passes.push_back({&elements[i], given[i].second});
     const Index rows = mask.shape(0), cols = mask.shape(1);
     auto out = new_mask(rows, cols);
     std::uint8_t* optr = out.mutable_data();
     const auto* mptr = static_cast<const std::uint8_t*>(mask.data());
     const Index mstride = mask.strides(0);
+    const bool simd = detail::avx2_allowed().load(std::memory_order_relaxed);
     {
         py::gil_scoped_release nogil;  // safe: raw buffers held by the caller / owned here
         // scratch kept per thread from frame to frame (each detector runs on one thread)
-        thread_local std::vector<std::uint8_t> tmp;
+        thread_local PackedScratch packed;
+        if (clean_packed(mptr, mstride, optr, rows, cols, passes, simd, packed)) return out;
+        thread_local std::vector<std::uint8_t> a, b;
         thread_local MorphScratch scratch;
-        tmp.resize(static_cast<size_t>(rows * cols));
-        pass(mptr, mstride, optr, tmp.data(), rows, cols, el, scratch);
+        a.resize(static_cast<size_t>(rows * cols));
+        b.resize(static_cast<size_t>(rows * cols));
+        const std::uint8_t* in = mptr;
+        Index in_stride = mstride;
+        for (size_t i = 0; i < passes.size(); ++i) {
+            // the last pass into the result, the others through the two scratch masks
+            std::uint8_t* to = i + 1 == passes.size() ? optr : (i % 2 == 0 ? a.data() : b.data());
+            morphology(in, in_stride, to, rows, cols, *passes[i].element, passes[i].op, scratch);
+            in = to;
+            in_stride = cols;
+        }
     }
     return out;
 }
@@ -496,13 +512,15 @@ void register_detection(py::module_& m) {
         [](bool allowed) { return detail::avx2_allowed().exchange(allowed); },
         py::arg("allowed"),
         "Testing hook: whether background.hpp's hand-written AVX2 passes may run (BackgroundModel."
-        "apply's row pass, hsv_bins' rows; where the CPU has AVX2; the portable loops otherwise, "
+        "apply's row pass, hsv_bins' rows; morphology.hpp's packed masks: clean_mask, open_mask, "
+        "close_mask; where the CPU has AVX2; the portable loops otherwise, "
         "the same results). Returns the previous setting; process-wide.");
 
     m.def(
         "close_mask",
         [](const py::object& mask, const py::object& element) {
-            return mask_pass(mask, element, "close_mask", close_mask);
+            return mask_passes(mask, {{element, MorphOp::dilate}, {element, MorphOp::erode}},
+                               "close_mask");
         },
         py::arg("mask"), py::arg("element"),
         "Closing (H, W) uint8 of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are "
@@ -511,9 +529,26 @@ void register_detection(py::module_& m) {
     m.def(
         "open_mask",
         [](const py::object& mask, const py::object& element) {
-            return mask_pass(mask, element, "open_mask", open_mask);
+            return mask_passes(mask, {{element, MorphOp::erode}, {element, MorphOp::dilate}},
+                               "open_mask");
         },
         py::arg("mask"), py::arg("element"),
         "Opening (H, W) uint8 of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are "
         "single runs: cv2.morphologyEx(mask, MORPH_OPEN, element)'s values.");
+
+    m.def(
+        "clean_mask",
+        [](const py::object& mask, const py::object& open_element,
+           const py::object& close_element) {
+            return mask_passes(mask,
+                               {{open_element, MorphOp::erode},
+                                {open_element, MorphOp::dilate},
+                                {close_element, MorphOp::dilate},
+                                {close_element, MorphOp::erode}},
+                               "clean_mask");
+        },
+        py::arg("mask"), py::arg("open_element"), py::arg("close_element"),
+        "Opening by open_element, then closing by close_element, of a (H, W) uint8/bool mask in "
+        "one call: (H, W) uint8, cv2.morphologyEx's values; a mask of 0 and one or two levels "
+        "(255 the upper) as bit planes, others byte by byte.");
 }

@@ -237,8 +237,8 @@ def mask_bins(binned: BinnedImage, mask: NDArray[Any]) -> BinnedImage: ...  # ma
 def sampled_mean(frame: NDArray[np.uint8], step: int) -> float: ...
 
 # testing hook: whether background.hpp's hand-written AVX2 passes may run (BackgroundModel.apply's
-# row pass, hsv_bins' rows; the portable loops otherwise, the same results); returns the previous
-# setting, process-wide
+# row pass, hsv_bins' rows, clean_mask / open_mask / close_mask's bit planes; the portable loops
+# otherwise, the same results); returns the previous setting, process-wide
 def _set_avx2(allowed: bool) -> bool: ...
 
 # closing of a (H, W) uint8/bool mask by a (kh, kw) element whose rows are single runs,
@@ -247,6 +247,12 @@ def close_mask(mask: NDArray[Any], element: NDArray[Any]) -> NDArray[np.uint8]: 
 
 # opening (an erosion, then a dilation), likewise, as cv2.morphologyEx(MORPH_OPEN)
 def open_mask(mask: NDArray[Any], element: NDArray[Any]) -> NDArray[np.uint8]: ...
+
+# opening by open_element, then closing by close_element, in one call -> new (H, W) uint8;
+# a mask of 0 and one or two levels (255 the upper) as bit planes, others byte by byte
+def clean_mask(
+    mask: NDArray[Any], open_element: NDArray[Any], close_element: NDArray[Any]
+) -> NDArray[np.uint8]: ...
 
 # boxes (K, 4) float64 cx, cy, w, h -> (K, B) float64, rows sum to 1 (0 for an empty box)
 # method "auto" | "direct" | "integral", as box_weights (the same histograms on every path)

@@ -1,5 +1,5 @@
-"""The mask's closing in C++ (pftrack._core.close_mask) against the NumPy reference
-(tests/reference/detection.py) and cv2.morphologyEx, bit for bit."""
+"""The mask's closing and opening in C++ (pftrack._core.close_mask, open_mask, clean_mask)
+against the NumPy reference (tests/reference/detection.py) and cv2.morphologyEx, bit for bit."""
 
 from __future__ import annotations
 
@@ -135,3 +135,147 @@ def test_close_and_open_mask_refuse_bad_input(fn) -> None:
         fn(mask.astype(np.float32), np.ones((3, 3), np.uint8))
     with pytest.raises(ValueError, match="non-empty"):
         fn(np.zeros((0, 5), np.uint8), np.ones((3, 3), np.uint8))
+
+
+# --- the packed path (stop 71): masks of 0 and at most two levels, 255 the upper, as bit planes
+
+
+@pytest.fixture(params=[True, False], ids=["avx2", "portable"])
+def simd_packing(request: pytest.FixtureRequest):
+    """Whether the packed path takes its AVX2 pack, passes and unpack or the portable loops
+    (bytes 8 at a time in 64-bit words) other CPUs run: `_core._set_avx2` turns AVX2 off. Each
+    test runs twice; both are held to OpenCV."""
+    before = _core._set_avx2(request.param)
+    yield request.param
+    _core._set_avx2(before)
+
+
+def _elements_in_use() -> list[tuple[np.ndarray, np.ndarray]]:
+    """Every (opening, closing) element pair `BlobExtractor` makes, over frame heights 1-2200."""
+    cfg = BlobConfig()
+    sizes = sorted({cfg.kernel_sizes(rows) for rows in range(1, 2200)})
+    assert len(sizes) >= 20 and (3, 5) in sizes and (7, 11) in sizes
+    return [
+        (
+            np.asarray(cv2.getStructuringElement(cv2.MORPH_RECT, (o, o)), np.uint8),
+            np.asarray(cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (c, c)), np.uint8),
+        )
+        for o, c in sizes
+    ]
+
+
+def _levels_mask(rng: np.random.Generator, rows: int, cols: int, levels: list[int]) -> np.ndarray:
+    """Blocks and speckle of `levels` (non-zero), 0 elsewhere, touching every border."""
+    m = np.zeros((rows, cols), np.uint8)
+    for _ in range(int(rng.integers(0, 8))):
+        x, y = int(rng.integers(-8, cols)), int(rng.integers(-8, rows))
+        w, h = int(rng.integers(1, 70)), int(rng.integers(1, 20))
+        m[max(y, 0) : y + h, max(x, 0) : x + w] = rng.choice(levels)
+    speckle = rng.random((rows, cols)) < rng.choice([0.0, 0.05, 0.5, 0.95])
+    m[speckle] = rng.choice(levels, int(speckle.sum()))
+    return m
+
+
+def _assert_clean_equals_opencv(mask: np.ndarray, k_open: np.ndarray, k_close: np.ndarray) -> None:
+    opened = _opencv(mask, k_open, cv2.MORPH_OPEN)
+    want = _opencv(opened, k_close)
+    np.testing.assert_array_equal(_core.clean_mask(mask, k_open, k_close), want)
+    np.testing.assert_array_equal(_core.open_mask(mask, k_open), opened)
+    np.testing.assert_array_equal(_core.close_mask(mask, k_close), _opencv(mask, k_close))
+
+
+_LEVELS = [[255], [127, 255], [1], [77], [200, 255]]
+
+
+def test_packed_clean_every_width_and_element_in_use(simd_packing: bool) -> None:
+    """Widths 1-600 (every tail of a 64-bit word and of the 16-byte packing), every element pair
+    the detector uses, 0/255, 0/127/255, 0/1, 0/m masks: OpenCV's values."""
+    rng = np.random.default_rng(600)
+    pairs = _elements_in_use()
+    for cols in range(1, 601):
+        k_open, k_close = pairs[cols % len(pairs)]
+        rows = int(rng.integers(1, 14))
+        levels = _LEVELS[cols % len(_LEVELS)]
+        _assert_clean_equals_opencv(_levels_mask(rng, rows, cols, levels), k_open, k_close)
+
+
+@pytest.mark.parametrize("levels", _LEVELS + [[127]])
+def test_packed_clean_frames_of_every_element_pair(levels: list[int], simd_packing: bool) -> None:
+    """Each element pair in use on frame-sized masks (rows and columns past its reach), with
+    foreground on the borders: OpenCV's values."""
+    rng = np.random.default_rng(sum(levels))
+    for k_open, k_close in _elements_in_use():
+        rows = int(rng.integers(k_close.shape[0], 3 * k_close.shape[0] + 40))
+        cols = int(rng.integers(k_close.shape[1], 400))
+        mask = _levels_mask(rng, rows, cols, levels)
+        mask[0, :] = mask[-1, :] = levels[-1]  # the borders: outside pixels never win
+        mask[:, 0] = levels[0]
+        _assert_clean_equals_opencv(mask, k_open, k_close)
+
+
+def test_packed_clean_of_a_bool_mask_and_a_strided_view(simd_packing: bool) -> None:
+    rng = np.random.default_rng(5)
+    k_open, k_close = _elements_in_use()[3]
+    mask = _levels_mask(rng, 50, 130, [255])
+    got = _core.clean_mask(mask != 0, k_open, k_close)
+    want = _opencv(_opencv((mask != 0).astype(np.uint8), k_open, cv2.MORPH_OPEN), k_close)
+    np.testing.assert_array_equal(got, want)
+    assert set(np.unique(got)) <= {0, 1}
+    view = _levels_mask(rng, 60, 200, [127, 255])[:, 7:150]
+    _assert_clean_equals_opencv(view, k_open, k_close)
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    rows=st.integers(1, 30),
+    cols=st.integers(1, 200),
+    kh=st.integers(1, 12),
+    kw=st.integers(1, 40),
+    simd=st.booleans(),
+)
+def test_packed_clean_any_elements_of_runs(
+    seed: int, rows: int, cols: int, kh: int, kw: int, simd: bool
+) -> None:
+    """Off-centre, asymmetric, wide (doubling) runs and one-row elements, on two-level masks."""
+    rng = np.random.default_rng(seed)
+    els = []
+    for _ in range(2):
+        el = np.zeros((kh, kw), np.uint8)
+        for y in range(kh):
+            if rng.random() < 0.8:
+                lo = int(rng.integers(0, kw))
+                el[y, lo : int(rng.integers(lo, kw)) + 1] = 1
+        if not el.any():
+            el[int(rng.integers(0, kh)), int(rng.integers(0, kw))] = 1
+        els.append(el)
+    mask = _levels_mask(rng, rows, cols, _LEVELS[seed % len(_LEVELS)])
+    before = _core._set_avx2(simd)
+    try:
+        _assert_clean_equals_opencv(mask, els[0], els[1])
+    finally:
+        _core._set_avx2(before)
+
+
+def test_three_levels_take_the_byte_path_with_the_same_values(simd_packing: bool) -> None:
+    """0, 127, 200, 255 (two levels under 255), and 0/50/100 (no 255): not two planes."""
+    rng = np.random.default_rng(9)
+    k_open, k_close = _elements_in_use()[1]
+    for levels in ([127, 200, 255], [50, 100], [1, 2, 3, 255]):
+        for cols in (5, 64, 65, 333):
+            mask = _levels_mask(rng, 40, cols, levels)
+            mask[0, 0], mask[-1, -1] = levels[0], levels[1]  # at least two levels present
+            _assert_clean_equals_opencv(mask, k_open, k_close)
+
+
+def test_clean_mask_refuses_bad_input() -> None:
+    mask = np.zeros((5, 5), np.uint8)
+    ok = np.ones((3, 3), np.uint8)
+    with pytest.raises(ValueError, match="not one run"):
+        _core.clean_mask(mask, ok, np.array([[1, 0, 1]], np.uint8))
+    with pytest.raises(ValueError, match="no set pixel"):
+        _core.clean_mask(mask, np.zeros((3, 3), np.uint8), ok)
+    with pytest.raises(TypeError, match="mask dtype"):
+        _core.clean_mask(mask.astype(np.float32), ok, ok)
+    with pytest.raises(ValueError, match="non-empty"):
+        _core.clean_mask(np.zeros((0, 5), np.uint8), ok, ok)

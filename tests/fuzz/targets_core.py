@@ -507,6 +507,18 @@ def _mask_pass(fn: Any) -> st.SearchStrategy[Any]:
     return call(fn, maybe(masks().flatmap(layout)), maybe(element))
 
 
+def _clean_mask() -> st.SearchStrategy[Any]:
+    """Calls of clean_mask: a mask (any levels, or 0/255 and 0/127/255: the bit planes) and two
+    small elements."""
+    element = hnp.arrays(st.sampled_from([np.uint8, np.bool_]), st.tuples(ints(1, 7), ints(1, 7)))
+    levels = st.sampled_from([(0, 255), (0, 127, 255), (0, 1)])
+    planes = st.tuples(levels, ints(1, 70), ints(1, 70), st.integers(0, 2**32 - 1)).map(
+        lambda a: np.random.default_rng(a[3]).choice(np.array(a[0], np.uint8), (a[1], a[2]))
+    )
+    mask = st.one_of(masks().flatmap(layout), planes)
+    return call(_core.clean_mask, maybe(mask), maybe(element), maybe(element))
+
+
 def _background(
     params: dict[str, Any], frames_: list[Any], mask: Any, rate: Any, boxes: Any
 ) -> Any:
@@ -584,6 +596,7 @@ TARGETS: list[Target] = [
     Target("sampled_mean", call(_core.sampled_mean, maybe(frames()), maybe(ints(-2, 64)))),
     Target("close_mask", _mask_pass(_core.close_mask)),
     Target("open_mask", _mask_pass(_core.open_mask)),
+    Target("clean_mask", _clean_mask()),
     Target(
         "median_frames",
         call(
