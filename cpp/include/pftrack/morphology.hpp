@@ -195,26 +195,6 @@ inline void morphology(const std::uint8_t* src, Index src_stride, std::uint8_t* 
     }
 }
 
-/// The closing (a dilation, then an erosion) of `src` (rows x cols, `src_stride` bytes a row)
-/// by `el` into `dst` (rows x cols, packed), as cv2.morphologyEx(MORPH_CLOSE). `tmp` is scratch
-/// of rows x cols bytes; no two of src, dst, tmp may alias.
-inline void close_mask(const std::uint8_t* src, Index src_stride, std::uint8_t* dst,
-                       std::uint8_t* tmp, Index rows, Index cols,
-                       const std::vector<ElementRow>& el, MorphScratch& s) {
-    morphology(src, src_stride, tmp, rows, cols, el, MorphOp::dilate, s);
-    morphology(tmp, cols, dst, rows, cols, el, MorphOp::erode, s);
-}
-
-/// The opening (an erosion, then a dilation) of `src` by `el` into `dst`, as
-/// cv2.morphologyEx(MORPH_OPEN); the arguments as `close_mask`'s.
-inline void open_mask(const std::uint8_t* src, Index src_stride, std::uint8_t* dst,
-                      std::uint8_t* tmp, Index rows, Index cols,
-                      const std::vector<ElementRow>& el, MorphScratch& s) {
-    morphology(src, src_stride, tmp, rows, cols, el, MorphOp::erode, s);
-    morphology(tmp, cols, dst, rows, cols, el, MorphOp::dilate, s);
-}
-
-
 // ---------------------------------------------------------------------------------------------
 // The packed path: a mask of at most two non-zero levels (0/255, 0/1, 0/127/255: the detectors'
 // masks with or without shadows) as bit planes, 64 pixels a word. Flat erosion and dilation
