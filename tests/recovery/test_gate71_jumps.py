@@ -248,3 +248,33 @@ def test_the_commands_say_it_in_one_line(
     write_mot(plain, _truth(tmp_path), exact=True)
     for command in ("recover", "smooth"):  # warnings are errors here: nothing is said
         assert main(["-q", command, str(plain), "--out", str(tmp_path / "p.txt")]) == 0
+
+
+def test_the_batch_says_it_of_each_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A folder's files through the batch layer: the summary's line per file, as one file's."""
+    import json
+
+    from pftrack.cli import main
+
+    folder = tmp_path / "in"
+    folder.mkdir()
+    rows = _restarted(_truth(tmp_path))
+    write_mot(folder / "restart.txt", rows, exact=True)
+    write_mot(folder / "plain.txt", _truth(tmp_path), exact=True)
+    _, report = fill_gaps(read_mot(folder / "restart.txt"))
+    assert report.n_jumps
+    for cmd in ("recover", "smooth"):
+        out_dir = tmp_path / cmd
+        argv = [cmd, str(folder), "--out", str(out_dir), "--workers", "0"]
+        with warnings.catch_warnings():
+            warnings.simplefilter("default")
+            assert main(argv) == 0
+        out = capsys.readouterr().out
+        said = [line for line in out.splitlines() if "too far apart for one object" in line]
+        assert len(said) == 1 and said[0].startswith("restart: "), out  # plain.txt: nothing
+        files = {f["name"]: f for f in json.loads((out_dir / "summary.json").read_text())["files"]}
+        assert files["plain"]["jump_holes"] == 0
+        assert files["restart"]["jump_holes"] >= 1
+        if cmd == "recover":  # the report's own words, its ratio included
+            assert said[0] == f"restart: {jump_note(report.n_jumps, report.largest_jump)}"
+            assert files["restart"]["largest_jump"] == pytest.approx(report.largest_jump)

@@ -256,6 +256,11 @@ class BatchSummary:
 
                 note = unfilled_note(e["long_holes"], e["longest_hole"], self.settings["max_gap"])
                 text.append(f"{e['name']}: {note}")
+            if e.get("jump_holes"):  # recover, smooth: two objects under one id, as one file
+                from pftrack.recovery.fill import jump_note
+
+                note = jump_note(e["jump_holes"], e.get("largest_jump", 0.0))
+                text.append(f"{e['name']}: {note}")
         if problems:
             text.extend(self.problems())
         return "\n".join(text)

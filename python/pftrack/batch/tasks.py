@@ -603,6 +603,7 @@ def recover_file(path: Path, options: RecoverOptions) -> TaskResult:
         "long_holes": rep.n_long_holes,  # longer than max_gap: left unfilled
         "longest_hole": rep.longest_hole,
         "jump_holes": rep.n_jumps,  # two objects under one id: left unfilled (issue 12)
+        "largest_jump": rep.largest_jump,
         "rows_out": len(filled),
         "seconds": time.perf_counter() - t0,
         "explain": rep.describe(),
