@@ -524,13 +524,11 @@ def read_tracks(path: PathLike) -> F64:
     :func:`pftrack.recovery.linking.read_tracks`, which the one-file commands import without
     this package.
     """
-    from pftrack.io.mot import far_boxes_note
+    from pftrack.io.mot import say_far_boxes
     from pftrack.recovery.linking import read_tracks as read
 
     rows = read(path)
-    far = far_boxes_note(rows)
-    if far is not None:  # the task's warning, as pftrack recover FILE says it
-        warn(f"{path}: {far}")
+    say_far_boxes(rows, path)  # the task's warning, as pftrack recover FILE says it
     return rows
 
 

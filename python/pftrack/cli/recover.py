@@ -83,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
     args.tracks = args.tracks[0]
     from pftrack.cli._signals import hold_interrupts
     from pftrack.io.atomic import check_output, check_replaceable
-    from pftrack.io.mot import far_boxes_note, is_mot_text, write_mot
+    from pftrack.io.mot import is_mot_text, say_far_boxes, write_mot
     from pftrack.recovery import fill_gaps, link_tracklets
     from pftrack.recovery.fill import copied_values, jump_note, unfilled_note
     from pftrack.recovery.linking import link_config_for, read_tracks
@@ -107,9 +107,7 @@ def run(args: argparse.Namespace) -> int:
 
         check_outside_frames({"--out": args.out}, args.video)
     rows = read_tracks(src)
-    far = far_boxes_note(rows)
-    if far is not None:  # was: carried along the tracks without a word
-        warn(f"{src}: {far}")
+    say_far_boxes(rows, src)
     n_links = 0
     if args.link:
         frames = None

@@ -61,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.cli._signals import hold_interrupts
     from pftrack.cli.recover import flag_note
     from pftrack.io.atomic import check_output, check_replaceable
-    from pftrack.io.mot import far_boxes_note, is_mot_text, write_mot
+    from pftrack.io.mot import is_mot_text, say_far_boxes, write_mot
     from pftrack.recovery.fill import jump_note, long_holes, short_holes, unfilled_note
     from pftrack.recovery.linking import link_config_for, read_tracks
     from pftrack.tracking import smooth_tracks
@@ -73,9 +73,7 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.out, what="--out", tracks=True)
     check_replaceable(args.out, "--out", is_mot_text, force=args.force, yours=TRACKS_YOURS)
     rows = read_tracks(src)
-    far = far_boxes_note(rows)
-    if far is not None:  # was: carried along the tracks without a word
-        warn(f"{src}: {far}")
+    say_far_boxes(rows, src)
     link = None if args.no_link else link_config_for(rows, args.max_gap, args.max_distance)
     result = smooth_tracks(rows, link=link, max_gap=args.max_gap)
     # the work is done: --out is written whatever comes (as in recover; after a Ctrl-C

@@ -818,6 +818,17 @@ def far_boxes_note(rows: NDArray[np.float64]) -> str | None:
     )
 
 
+def say_far_boxes(rows: NDArray[np.float64], name: object) -> None:
+    """Warn ``NAME: <far_boxes_note>`` when :func:`far_boxes_note` has something to say.
+
+    The one warning of ``pftrack recover`` and ``smooth`` (one file, or each file of a batch)
+    of tracks rows read from `name`.
+    """
+    far = far_boxes_note(rows)
+    if far is not None:  # was: carried along the tracks without a word
+        warn(f"{name}: {far}")
+
+
 def group_by_frame(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
     """Split rows by frame number: ``{frame: (k, 10) rows}``.
 
