@@ -53,7 +53,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--link", action="store_true", help="join fragments of one object first")
     add_max_distance(p)
     p.add_argument("--video", help="video or image folder for the colour term of --link: "
-                   "only the frames of fragment ends are read, in one pass; refused when it "
+                   "only the frames of fragment ends are read, in one pass, then those of the "
+                   "holes' two sides (a hole whose sides each look more like another object "
+                   "than like each other is left unfilled, and said); refused when it "
                    "has fewer frames than the tracks, or boxes start more than a tenth of "
                    "its width or height past its right or bottom edge (default: none, motion "
                    "and size only)")  # fmt: skip
@@ -85,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.atomic import check_output, check_replaceable
     from pftrack.io.mot import is_mot_text, say_far_boxes, write_mot
     from pftrack.recovery import fill_gaps, link_tracklets
-    from pftrack.recovery.fill import copied_values, jump_note, unfilled_note
+    from pftrack.recovery.fill import copied_values, jump_note, swap_note, unfilled_note
     from pftrack.recovery.linking import link_config_for, read_tracks
 
     src = Path(args.tracks)
@@ -109,23 +111,24 @@ def run(args: argparse.Namespace) -> int:
     rows = read_tracks(src)
     say_far_boxes(rows, src)
     n_links = 0
-    if args.link:
-        frames = None
-        if args.video:
-            from pftrack.io.video import FrameSequence
+    frames = None
+    if args.video:
+        from pftrack.io.video import FrameSequence
 
-            frames = FrameSequence(args.video)  # read when the colour term asks, in one pass
-            check_video(args.video, frames, rows, src)
-        cfg = link_config_for(rows, args.max_gap, args.max_distance)
-        try:
+        frames = FrameSequence(args.video)  # read when the colour term asks, in one pass
+        check_video(args.video, frames, rows, src)
+    try:
+        if args.link:
+            cfg = link_config_for(rows, args.max_gap, args.max_distance)
             rows, mapping = link_tracklets(rows, cfg, frames)
-        finally:
-            if frames is not None:
-                frames.close()
-        n_links = len(mapping)
-    t0 = time.perf_counter()
-    filled, rep = fill_gaps(rows, args.method, args.max_gap, seed=args.seed)
-    dt = time.perf_counter() - t0
+            n_links = len(mapping)
+        t0 = time.perf_counter()
+        # with the video, the holes' sides too (a second pass): two neighbours under one id
+        filled, rep = fill_gaps(rows, args.method, args.max_gap, seed=args.seed, frames=frames)
+        dt = time.perf_counter() - t0
+    finally:
+        if frames is not None:
+            frames.close()
     # the work is done: --out is written whatever comes (held before the write, as the
     # commands with several outputs hold before their renames: held after it, a Ctrl-C
     # between the rename and the hold said "no output was changed" of a replaced --out; after
@@ -143,6 +146,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"{src}: {unfilled_note(rep.n_long_holes, rep.longest_hole, args.max_gap)}", file=to)
     if rep.n_jumps:  # was filled without a word: a path drawn between two objects (issue 12)
         warn(f"{src}: {jump_note(rep.n_jumps, rep.largest_jump)}")
+    if rep.n_swaps:  # with --video: two neighbours under one id (issue 12, stop 72)
+        warn(f"{src}: {swap_note(rep.n_swaps, rep.largest_swap)}")
     if args.explain:
         print(rep.describe(), file=to)
     return 0

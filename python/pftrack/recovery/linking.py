@@ -53,6 +53,7 @@ __all__ = [
     "check_rows",
     "check_unique",
     "filled_mask",
+    "frame_histograms",
     "gate_for_rows",
     "link_cost_matrix",
     "link_costs",
@@ -262,30 +263,51 @@ def split_tracks(rows: F64) -> dict[int, F64]:
     return {int(r[i, 1]): r[i:j] for i, j in zip(starts, ends, strict=True)}
 
 
+def frame_histograms(
+    boxes: dict[int, F64], frames: Sequence[NDArray[np.uint8]]
+) -> dict[int, F64 | None]:
+    """Colour histograms of boxes ``(K, 4)`` ``left, top, width, height`` at 0-based frames.
+
+    Returns, per frame index of `boxes`, the ``(K, B)`` histograms of its boxes
+    (:func:`pftrack.particle_filter.colour.box_histograms`, the particle filters' binning; a
+    box with nothing to count gets a row of zeros), or None where `frames` has no such frame.
+    The frames are asked for in increasing order, each once, and binned one at a time: a
+    sequence that reads a video on demand (:class:`pftrack.io.video.FrameSequence`) decodes it
+    in one pass, holding one frame. The linker's colour term (:func:`link_costs`) and the
+    fill's swap rule (:func:`pftrack.recovery.fill.swap_holes`) read frames through it.
+    """
+    out: dict[int, F64 | None] = {}
+    n = len(frames)
+    for f in sorted(boxes):
+        if not 0 <= f < n:
+            out[f] = None
+            continue
+        b = boxes[f]
+        out[f] = box_histograms(hsv_bins(frames[f]), _to_cxcywh(b)) if len(b) else np.zeros((0, 0))
+    return out
+
+
 def _end_histograms(
     tracks: dict[int, F64], ends: Iterable[tuple[int, bool]], frames: Sequence[NDArray[np.uint8]]
 ) -> dict[tuple[int, bool], F64 | None]:
     """Colour histogram of the box at each fragment end of `ends` (id, last row or first).
 
-    None where there is no frame or nothing to count. The frames are asked for in increasing
-    order, each once, and binned one at a time: a sequence that reads a video on demand
-    (:class:`pftrack.io.video.FrameSequence`) decodes it in one pass, holding one frame.
+    None where there is no frame or nothing to count (:func:`frame_histograms`, one pass).
     """
     at: dict[int, list[tuple[int, bool]]] = {}
     for key in ends:
         tid, last = key
         at.setdefault(int(tracks[tid][-1 if last else 0, 0]) - 1, []).append(key)
+    boxes = {
+        f: np.array([tracks[tid][-1 if last else 0, 2:6] for tid, last in keys])
+        for f, keys in at.items()
+    }
+    hists = frame_histograms(boxes, frames)
     out: dict[tuple[int, bool], F64 | None] = {}
-    n = len(frames)
-    for f in sorted(at):
-        image = hsv_bins(frames[f]) if 0 <= f < n else None
-        for tid, last in at[f]:
-            if image is None:
-                out[tid, last] = None
-                continue
-            row = tracks[tid][-1 if last else 0]
-            hist = box_histograms(image, _to_cxcywh(row[2:6])[None])[0]
-            out[tid, last] = hist if hist.sum() > 0 else None
+    for f, keys in at.items():
+        h = hists[f]
+        for k, key in enumerate(keys):
+            out[key] = None if h is None or h[k].sum() <= 0 else h[k]
     return out
 
 
