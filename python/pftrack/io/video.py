@@ -2985,13 +2985,14 @@ class FrameSource:
         as :meth:`recount` takes it, for any later pass.
         """
         self.n_frames, self.count_known = decoded, True
+        path = Path(self.name) if self.path is None else self.path  # a file: path is set
         warn_outside(
             f"{self.path}: its header says {counted(header, 'frame')} but {decoded} were read "
             f"to its end: the header is wrong, and what was chosen from its count before the "
             f"run was chosen from frames 1-{header} alone (the built-in detector's background, "
             f"from 30 frames spread over the video); every frame was tracked. Rewrite the "
-            f"header for a run that sees the whole video: ffmpeg -i {self.path.name} -c copy "
-            f"fixed{self.path.suffix}",
+            f"header for a run that sees the whole video: ffmpeg -i {path.name} -c copy "
+            f"fixed{path.suffix}",
             UserWarning,
         )
 
