@@ -28,6 +28,7 @@ import numbers
 import os
 import signal
 import socket
+import stat
 import threading
 import time
 import traceback
@@ -288,9 +289,58 @@ class BatchSummary:
         # or with the same words but their own names (was: one line each); warnings too
         text = said_once(raised, noun, "warning")
         text += said_once([(e["name"], e["error"]) for e in self.failed], noun, "error")
+        text += said_once(
+            [(e["name"], kept_note(e["kept"], self.out_dir)) for e in self.failed if e.get("kept")],
+            noun,
+            "warning",
+        )
         if self.unwritten and unwritten:
             text.append(f"error: {self.unwritten}")
         return text
+
+
+def kept_note(kept: Sequence[str], out_dir: Path) -> str:
+    """What a failed task's outputs of an earlier run, left as they were in `out_dir`, are.
+
+    A re-run whose task fails writes none of its outputs, and those an earlier run wrote stay
+    (outputs are replaced whole or not at all); but beside the others' new outputs they look
+    like this run's, and ``pftrack recover`` or ``pftrack eval`` of the folder reads them as
+    such (a user trial: a sequence whose images changed, re-run and failed, kept its tracks of
+    the old images, said only by the table's ``failed``).
+    """
+    files = " and ".join([", ".join(kept[:-1]), kept[-1]] if len(kept) > 1 else kept)
+    are, they, were = ("are", "they", "were") if len(kept) > 1 else ("is", "it", "was")
+    return (
+        f"{files} in {out_dir} {are} an earlier run's, left as {they} {were}: not this run's "
+        "(it failed), nor, if its inputs or settings changed since, theirs; move "
+        f"{'them' if len(kept) > 1 else 'it'} away before reading the folder's results "
+        "(pftrack recover, eval)"
+    )
+
+
+def _stat_of(path: Path) -> tuple[int, int, int, int] | None:
+    """``(st_dev, st_ino, st_size, st_mtime_ns)`` of a regular file `path`, else None."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns) if stat.S_ISREG(st.st_mode) else None
+
+
+def _outputs_there(
+    out_dir: Path, name: str, suffixes: Sequence[str]
+) -> dict[str, tuple[int, int, int, int]]:
+    """The outputs of task `name` in `out_dir` before the run, by name: what may stay of them.
+
+    Compared with the same files when the task fails (:func:`_stat_of`): those unchanged are
+    an earlier run's (an output this run replaced is a new file: another inode).
+    """
+    there = {}
+    for file in (f"{name}{s}" for s in (".txt", ".json", *suffixes)):
+        was = _stat_of(out_dir / file)
+        if was is not None:
+            there[file] = was
+    return there
 
 
 def said_once(messages: list[tuple[str, str]], noun: str, level: str) -> list[str]:
@@ -2213,6 +2263,7 @@ def run_jobs(
     entries: dict[str, dict[str, Any]] = {}
     notes: dict[str, str] = {}
     prints = {job.name: fingerprint(job.reads) for job in jobs}  # before the tasks read them
+    found = {job.name: _outputs_there(out, job.name, suffixes) for job in jobs}
     pending: list[Job] = []
     refused = [job for job in jobs if job.refused is not None]  # certain to fail: not sent
     for job in jobs:
@@ -2265,6 +2316,10 @@ def run_jobs(
             }
             if outcome.host is not None:  # where it failed, as a done entry says where it ran
                 entries[job.name]["host"] = outcome.host
+            kept = [name for name, was in found[job.name].items() if _stat_of(out / name) == was]
+            if kept:  # an earlier run's, as they were: said (was: beside the new outputs,
+                # read by pftrack recover and eval of the folder as this run's, unsaid)
+                entries[job.name]["kept"] = kept
         if job.name in notes:
             entries[job.name]["note"] = notes[job.name]
         say = _SAY_WARNING.get()

@@ -2950,6 +2950,8 @@ class FrameSource:
         short = decoded < header
         if short:
             said.append(f"its header says {header}")
+        elif 0 < header < decoded and self.path is not None:
+            self._warn_long(header, decoded)
         elif not header and self._span_ms is not None and last_ms is not None and decoded:
             step = self._span_ms / max(self.n_frames, 1)  # one frame, at the header's rate
             if self._span_ms - (last_ms + step) > max(3 * step, 1000.0):
@@ -2968,6 +2970,29 @@ class FrameSource:
         warn_outside(
             f"{self.path} ended after {counted(decoded, 'frame')} but "
             f"{' and '.join(said)}{damaged}",
+            UserWarning,
+        )
+
+    def _warn_long(self, header: int, decoded: int) -> None:
+        """Warn that a video read to its end held more frames than its header says; count them.
+
+        Every frame was read and tracked, but what was chosen from the header's count before
+        the run was chosen from its first `header` frames only: the spread bootstrap's
+        background frames (the built-in detector's), a progress bar's total (a user trial: an
+        AVI whose header said 20 of its 40 frames gave tracks other than the mended file's,
+        without a word; a frame asked for past the header's count was recounted and said,
+        :meth:`recount`, but nothing asks when no detection lies past it). The count is taken,
+        as :meth:`recount` takes it, for any later pass.
+        """
+        self.n_frames, self.count_known = decoded, True
+        path = Path(self.name) if self.path is None else self.path  # a file: path is set
+        warn_outside(
+            f"{self.path}: its header says {counted(header, 'frame')} but {decoded} were read "
+            f"to its end: the header is wrong, and what was chosen from its count before the "
+            f"run was chosen from frames 1-{header} alone (the built-in detector's background, "
+            f"from 30 frames spread over the video); every frame was tracked. Rewrite the "
+            f"header for a run that sees the whole video: ffmpeg -i {path.name} -c copy "
+            f"fixed{path.suffix}",
             UserWarning,
         )
 
