@@ -1075,6 +1075,17 @@ def test_no_track_warning_of_the_built_in_detector_blames_it():
     ]
 
 
+def test_no_track_warning_of_one_frame_says_the_detector_needs_more(scene):
+    # a user trial (stop 72): one frame said "found no object", true but no help; the
+    # background the detector differences against is learned over frames
+    said = _no_track_said(pftrack.Tracker(seed=0), [scene.frames[30]])  # people in it
+    assert said == [
+        "no track over 1 frame: the built-in detector found no object: it finds objects by "
+        "their difference to a background learned over the frames, which one frame cannot "
+        "give (give more frames, or a detector's boxes)"
+    ]
+
+
 def test_no_track_warning_says_min_conf_left_the_built_in_detectors_objects_out(scene):
     """A user trial: ``--min-conf 1`` with the built-in detector said it "found no object",
     though it found hundreds and min_conf left every one out."""

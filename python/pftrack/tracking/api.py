@@ -1606,6 +1606,12 @@ class Tracker:
                 f"{blobs.min_fill:g}): people too small in the frame, or noise? give a person "
                 "detector's boxes (pftrack track --detections; Tracker.update's dets)"
             )
+        if not self._given and self.frame_count == 1:  # a still image: no background to learn
+            return (
+                "the built-in detector found no object: it finds objects by their difference "
+                "to a background learned over the frames, which one frame cannot give (give "
+                "more frames, or a detector's boxes)"
+            )
         if not self._given:
             return "the built-in detector found no object (no detection was given)"
         if self.config.sampler == "rjmcmc" and self._tracker.kept_given:
