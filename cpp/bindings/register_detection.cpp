@@ -63,8 +63,9 @@ std::vector<ElementRow> to_element(const py::array& k, const char* fn) {
 }
 
 /// `passes` of a (H, W) uint8/bool mask, checked, into a new mask: the packed path
-/// (morphology.hpp `clean_packed`) for a mask of two levels or three with 255, else the byte
-/// path (`morphology`, pass after pass through a scratch mask).
+/// (morphology.hpp `clean_packed_blocks`: `clean_packed` of the blocks of non-empty rows) for a
+/// mask of two levels or three with 255, else the byte path (`morphology`, pass after pass
+/// through a scratch mask).
 py::array_t<std::uint8_t> mask_passes(const py::object& mask_in,
                                       const std::vector<std::pair<py::object, MorphOp>>& given,
                                       const char* fn) {
@@ -89,7 +90,7 @@ py::array_t<std::uint8_t> mask_passes(const py::object& mask_in,
         py::gil_scoped_release nogil;  // safe: raw buffers held by the caller / owned here
         // scratch kept per thread from frame to frame (each detector runs on one thread)
         thread_local PackedScratch packed;
-        if (clean_packed(mptr, mstride, optr, rows, cols, passes, simd, packed)) return out;
+        if (clean_packed_blocks(mptr, mstride, optr, rows, cols, passes, simd, packed)) return out;
         thread_local std::vector<std::uint8_t> a, b;
         thread_local MorphScratch scratch;
         a.resize(static_cast<size_t>(rows * cols));

@@ -249,7 +249,8 @@ def close_mask(mask: NDArray[Any], element: NDArray[Any]) -> NDArray[np.uint8]: 
 def open_mask(mask: NDArray[Any], element: NDArray[Any]) -> NDArray[np.uint8]: ...
 
 # opening by open_element, then closing by close_element, in one call -> new (H, W) uint8;
-# a mask of 0 and one or two levels (255 the upper) as bit planes, others byte by byte
+# a mask of 0 and one or two levels (255 the upper) as bit planes, others byte by byte; the
+# planes cover only the blocks of rows near a non-zero byte (the others are 0)
 def clean_mask(
     mask: NDArray[Any], open_element: NDArray[Any], close_element: NDArray[Any]
 ) -> NDArray[np.uint8]: ...

@@ -279,3 +279,65 @@ def test_clean_mask_refuses_bad_input() -> None:
         _core.clean_mask(mask.astype(np.float32), ok, ok)
     with pytest.raises(ValueError, match="non-empty"):
         _core.clean_mask(np.zeros((0, 5), np.uint8), ok, ok)
+
+
+# --- the packed path by blocks of rows (stop 72): rows far from every non-zero row are left out
+
+
+def _banded_mask(
+    rng: np.random.Generator, rows: int, cols: int, bands: list[tuple[int, int]], levels: list[int]
+) -> np.ndarray:
+    """0 but for `bands` of rows [first, last], each full of blocks, speckle and whole rows of
+    `levels` (whole rows: an erosion at a band's edge keeps them only if its rows above and
+    below are read)."""
+    m = np.zeros((rows, cols), np.uint8)
+    for first, last in bands:
+        part = _levels_mask(rng, last - first + 1, cols, levels)
+        part[0, :] = levels[-1]
+        part[-1, :] = levels[0]
+        m[first : last + 1] = part
+    return m
+
+
+def test_packed_clean_by_blocks_at_every_gap_near_the_margin(simd_packing: bool) -> None:
+    """Two bands of rows whose gap is every count from 0 to 2 margin + 3 empty rows (margin: the
+    passes' summed vertical reach; at 2 margin + 1 the bands are cleaned as two images), bands at
+    the top and bottom edges and inside, for the first 8 element pairs in use: OpenCV's values
+    (and the NumPy reference's at every fourth gap)."""
+    rng = np.random.default_rng(72)
+    for k_open, k_close in _elements_in_use()[:8]:
+        margin = 2 * (k_open.shape[0] // 2) + 2 * (k_close.shape[0] // 2)
+        for gap in range(2 * margin + 4):
+            for top in (0, 1, margin, margin + 3):
+                h1, h2 = int(rng.integers(1, 9)), int(rng.integers(1, 9))
+                first2 = top + h1 + gap
+                rows = first2 + h2 + int(rng.choice([0, 1, margin, margin + 5]))
+                cols = int(rng.integers(1, 140))
+                bands = [(top, top + h1 - 1), (first2, first2 + h2 - 1)]
+                levels = _LEVELS[(gap + top) % len(_LEVELS)]
+                mask = _banded_mask(rng, rows, cols, bands, levels)
+                _assert_clean_equals_opencv(mask, k_open, k_close)
+                if gap % 4 == 0:  # the NumPy reference too (slower)
+                    want = close_mask_reference(open_mask_reference(mask, k_open), k_close)
+                    np.testing.assert_array_equal(_core.clean_mask(mask, k_open, k_close), want)
+
+
+def test_packed_clean_by_blocks_of_an_empty_and_a_full_mask(simd_packing: bool) -> None:
+    k_open, k_close = _elements_in_use()[1]
+    for rows, cols in ((1, 1), (7, 33), (360, 480)):
+        _assert_clean_equals_opencv(np.zeros((rows, cols), np.uint8), k_open, k_close)
+        _assert_clean_equals_opencv(np.full((rows, cols), 255, np.uint8), k_open, k_close)
+
+
+def test_packed_clean_by_blocks_with_other_levels_in_each_band(simd_packing: bool) -> None:
+    """Bands far apart with their own levels (0/100 and 0/200: three values in the mask, not in
+    a band), and a band with three levels after a packed one (the whole mask by the byte path
+    after the first band was written): OpenCV's values."""
+    rng = np.random.default_rng(3)
+    k_open, k_close = _elements_in_use()[1]
+    a = _banded_mask(rng, 120, 97, [(5, 30), (70, 100)], [100])
+    a[70:101][a[70:101] != 0] = 200
+    _assert_clean_equals_opencv(a, k_open, k_close)
+    b = _banded_mask(rng, 120, 97, [(5, 30), (70, 100)], [127, 255])
+    b[80, 10:40] = 60  # a third level in the second band only
+    _assert_clean_equals_opencv(b, k_open, k_close)

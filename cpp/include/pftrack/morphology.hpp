@@ -24,6 +24,7 @@
 #endif
 
 #include "check.hpp"
+#include "mask_scan.hpp"
 #include "types.hpp"
 
 namespace pftrack {
@@ -400,6 +401,45 @@ __attribute__((target("avx2"), always_inline)) inline __m256i expand32_avx2(std:
     return _mm256_cmpeq_epi8(_mm256_and_si256(v, bit), bit);
 }
 
+/// `zero_bytes` by 32-byte stores, the last n % 32 bytes by one overlapping store (n >= 32)
+/// or memset.
+__attribute__((target("avx2"))) inline void zero_bytes_avx2(std::uint8_t* p, Index n) {
+    __m256i z = _mm256_setzero_si256();
+    // opaque to the optimiser, which would otherwise make the loop a call of memset
+    __asm__("" : "+x"(z));
+    Index i = 0;
+    for (; i + 32 <= n; i += 32) _mm256_storeu_si256(reinterpret_cast<__m256i*>(p + i), z);
+    if (i == n) return;
+    if (n >= 32)
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(p + n - 32), z);
+    else
+        std::memset(p + i, 0, static_cast<size_t>(n - i));
+}
+
+/// Whether the n bytes at p are all 0: 64 bytes a test (AVX2), the last n % 64 by overlapping
+/// loads (n >= 32) or byte by byte.
+/// The 32 bytes at p (unaligned).
+__attribute__((target("avx2"), always_inline)) inline __m256i load32_avx2(const std::uint8_t* p) {
+    return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
+}
+
+__attribute__((target("avx2"))) inline bool all_zero_avx2(const std::uint8_t* p, Index n) {
+    Index i = 0;
+    for (; i + 64 <= n; i += 64) {
+        const __m256i o = _mm256_or_si256(load32_avx2(p + i), load32_avx2(p + i + 32));
+        if (!_mm256_testz_si256(o, o)) return false;
+    }
+    if (i == n) return true;
+    if (n >= 32) {  // [i, n) lies within [j, j + 32) and [n - 32, n)
+        const Index j = i < n - 32 ? i : n - 32;
+        const __m256i o = _mm256_or_si256(load32_avx2(p + j), load32_avx2(p + n - 32));
+        return _mm256_testz_si256(o, o) != 0;
+    }
+    for (; i < n; ++i)
+        if (p[i] != 0) return false;
+    return true;
+}
+
 /// Each row's first cols / 32 * 32 bytes from the planes (AVX2): 255 where b is set (with
 /// `two`), ma where only a is, 0 elsewhere.
 __attribute__((target("avx2"))) inline void unpack_rows_avx2(const std::uint64_t* pa,
@@ -458,6 +498,28 @@ PFTRACK_VECTOR_CLONES static void word_extremum_fill(bool dilate, const std::uin
         for (Index k = 0; k < n; ++k) o[k] = ((o[k] & a[k]) & valid[k]) | (fill & ~valid[k]);
 }
 
+/// n zero bytes at p: 32-byte stores where `avx2`, else memset. (glibc's memset takes `rep
+/// stosb` for a few kilobytes, which callgrind counts as one instruction a byte: the rows
+/// `clean_packed_blocks` leaves out would have counted as much as packing them.)
+/// Whether the n bytes at p are all 0 (`all_zero_avx2` where `avx2`).
+inline bool bytes_all_zero(const std::uint8_t* p, Index n, bool avx2) {
+#ifdef PFTRACK_MORPH_AVX2
+    if (avx2) return all_zero_avx2(p, n);
+#endif
+    (void)avx2;
+    Index x = skip_zero_words(p, 0, n);
+    while (x < n && p[x] == 0) ++x;  // the word found, or the last n % 8
+    return x == n;
+}
+
+inline void zero_bytes(std::uint8_t* p, Index n, bool avx2) {
+#ifdef PFTRACK_MORPH_AVX2
+    if (avx2) return zero_bytes_avx2(p, n);
+#endif
+    (void)avx2;
+    std::memset(p, 0, static_cast<size_t>(n));
+}
+
 /// The bits of 8 bytes that are not 0 (bit j: byte j), without SIMD.
 inline std::uint64_t nonzero_bits8(std::uint64_t x) {
     constexpr std::uint64_t lo7 = 0x7f7f7f7f7f7f7f7fULL, hi = 0x8080808080808080ULL;
@@ -473,6 +535,7 @@ struct PackedScratch {
     std::vector<std::vector<std::uint64_t>> runs;  // one per distinct run, and the levels
     std::vector<std::uint64_t> level;
     std::vector<std::uint64_t> expand;  // 256 entries: byte -> 8 bytes 0x00 / 0xff
+    std::vector<std::pair<Index, Index>> groups;  // clean_packed_blocks' rows: first, last
 };
 
 /// One pass of `clean_packed`: an element and an operation.
@@ -738,6 +801,62 @@ inline bool clean_packed(const std::uint8_t* src, Index src_stride, std::uint8_t
     }
     return true;
 #endif
+}
+
+/// `clean_packed` of the blocks of rows that hold a non-zero byte, each taken with `margin`
+/// rows above and below (the sum of the passes' vertical reaches) as an image of its own; every
+/// other row of dst is 0. The same bytes as `clean_packed` of the whole mask: with the anchor in
+/// every element an erosion never grows the foreground and each dilation grows it by its reach,
+/// so after every pass the rows of a block within its remaining margin of the block's edge are
+/// still 0, in the whole mask as in the block (an erosion there sees its own 0 pixel; a dilation
+/// gets 0 from an outside row as from a left-out one), and rows more than `margin` from a
+/// non-zero row stay 0. Groups of non-zero rows closer than 2 margin + 1 empty rows share a
+/// block. A foreground mask is mostly empty rows (PETS09's raw masks: 141 of 360 rows hold a
+/// pixel, in one band), which the packed planes would otherwise pack, pass and unpack. Returns
+/// false, dst undefined, where `clean_packed` of a block does (a third level in it, or an
+/// element without its anchor): the caller then takes the byte path for the whole mask.
+inline bool clean_packed_blocks(const std::uint8_t* src, Index src_stride, std::uint8_t* dst,
+                                Index rows, Index cols, const std::vector<PackedPass>& passes,
+                                bool simd, PackedScratch& s) {
+    Index margin = 0;
+    for (const PackedPass& p : passes) {
+        Index reach = 0;
+        bool anchor = false;
+        for (const ElementRow& r : *p.element) {
+            reach = std::max({reach, -r.dy, r.dy});
+            anchor = anchor || (r.dy == 0 && r.lo <= 0 && r.hi >= 0);
+        }
+        if (!anchor) return false;  // the argument above needs it (and clean_packed too)
+        margin += reach;
+    }
+#ifdef PFTRACK_MORPH_AVX2
+    const bool avx2 = simd && __builtin_cpu_supports("avx2");
+#else
+    const bool avx2 = false;
+#endif
+    s.groups.clear();
+    for (Index y = 0; y < rows; ++y) {
+        if (detail::bytes_all_zero(src + y * src_stride, cols, avx2)) continue;
+        if (!s.groups.empty() && y - s.groups.back().second - 1 <= 2 * margin)
+            s.groups.back().second = y;
+        else
+            s.groups.emplace_back(y, y);
+    }
+    Index done = 0;  // rows of dst written
+    const auto zero_rows = [&](Index to) {
+        detail::zero_bytes(dst + done * cols, (to - done) * cols, avx2);
+    };
+    for (const auto& [first, last] : s.groups) {
+        const Index a = std::max<Index>(first - margin, 0);
+        const Index b = std::min<Index>(last + 1 + margin, rows);
+        zero_rows(a);
+        if (!clean_packed(src + a * src_stride, src_stride, dst + a * cols, b - a, cols, passes,
+                          simd, s))
+            return false;
+        done = b;
+    }
+    zero_rows(rows);
+    return true;
 }
 
 }  // namespace pftrack

@@ -361,7 +361,8 @@ class BlobExtractor:
         (tests/detection/test_morphology.py). A mask of 0 and at most two levels, 255 the upper
         (the detectors' 0/255 and 0/127/255), is cleaned as bit planes, 64 pixels a word: the
         cleaned planes of ``mask != 0`` and ``mask == 255``, since flat erosion and dilation
-        commute with a threshold; any other mask byte by byte.
+        commute with a threshold; any other mask byte by byte. Only the blocks of rows within
+        the passes' summed reach of a non-zero row are cleaned; the other rows are 0.
         """
         k_open, k_close = self._elements(raw.shape[0])
         closed: NDArray[np.uint8] = _core.clean_mask(raw, k_open, k_close)
