@@ -9,6 +9,10 @@
 
 #include "pftrack/check.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace pftrack {
 
 /// A grey uint8 image: `rows` x `cols` pixels, row `r` at `data + r * stride`.
@@ -52,24 +56,178 @@ struct Weights {
     }
 };
 
-/// Scharr derivatives (d/dx, d/dy, both 32 times the gradient) of pixel (r, c) of `img`, rows
-/// and columns beyond the edges reflected (-1 -> 1) as OpenCV's calcScharrDeriv does; 0 outside
-/// the image (its derivative border is constant 0).
-inline void scharr_at(const GreyImage& img, int r, int c, int& dx, int& dy) {
-    if (r < 0 || r >= img.rows || c < 0 || c >= img.cols) {
-        dx = dy = 0;
-        return;
+/// One step's mismatch sums of a window: J, the next image's window (win_h + 1 rows of `bs`
+/// bytes), bilinear at weights `v`, less the previous window's values `iv` (int16, rows of
+/// `ws`), times its derivatives `dv` (Ix, Iy pairs, rows of 2 ws). The first `simd_w` columns
+/// of a row go to two sets of four float lanes as OpenCV's SSE loop sums them (qb0: pixels 0
+/// and 1 of each 8, paired with 4 and 5, lanes [x, y, x, y]; qb1: pixels 2 and 3 with 6 and 7),
+/// whose lane-by-lane sum is written to `s`; the rest go to `b1`, `b2` one by one. Every integer
+/// is exact; the float adds are OpenCV's, in its order.
+inline void sums_of_window(const std::uint8_t* jb, int bs, const std::int16_t* iv,
+                           const std::int16_t* dv, int ws, int win_w, int win_h, int simd_w,
+                           const Weights& v, float* s, float& b1, float& b2) {
+#if defined(__SSE2__)
+    const __m128i z = _mm_setzero_si128();
+    const auto pair = [](int lo, int hi) {
+        return _mm_set1_epi32(static_cast<int>((static_cast<unsigned>(hi) << 16) |
+                                               (static_cast<unsigned>(lo) & 0xffffu)));
+    };
+    const __m128i qw0 = pair(v.w00, v.w01), qw1 = pair(v.w10, v.w11);
+    const __m128i qdelta = _mm_set1_epi32(1 << (kWBits - 5 - 1));
+    __m128 qb0 = _mm_setzero_ps(), qb1 = _mm_setzero_ps();
+    const auto ld = [&](const std::uint8_t* q) {
+        return _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(q)), z);
+    };
+#else
+    float q0[4] = {0, 0, 0, 0}, q1[4] = {0, 0, 0, 0};
+#endif
+    for (int y = 0; y < win_h; ++y) {
+        const std::uint8_t* j0 = jb + y * bs;
+        const std::uint8_t* j1 = j0 + bs;
+        const std::int16_t* ir = iv + y * ws;
+        const std::int16_t* dr = dv + y * ws * 2;
+        int x = 0;
+        for (; x < simd_w; x += 8) {
+#if defined(__SSE2__)
+            const __m128i v00 = ld(j0 + x), v01 = ld(j0 + x + 1);
+            const __m128i v10 = ld(j1 + x), v11 = ld(j1 + x + 1);
+            __m128i t0 = _mm_add_epi32(
+                _mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi16(v00, v01), qw0), qdelta),
+                _mm_madd_epi16(_mm_unpacklo_epi16(v10, v11), qw1));
+            __m128i t1 = _mm_add_epi32(
+                _mm_add_epi32(_mm_madd_epi16(_mm_unpackhi_epi16(v00, v01), qw0), qdelta),
+                _mm_madd_epi16(_mm_unpackhi_epi16(v10, v11), qw1));
+            t0 = _mm_srai_epi32(t0, kWBits - 5);
+            t1 = _mm_srai_epi32(t1, kWBits - 5);
+            const __m128i diff0 = _mm_sub_epi16(
+                _mm_packs_epi32(t0, t1), _mm_loadu_si128(reinterpret_cast<const __m128i*>(ir + x)));
+            const __m128i diff2 = _mm_unpacklo_epi16(diff0, diff0);  // d0 d0 d1 d1 ...
+            const __m128i diff1 = _mm_unpackhi_epi16(diff0, diff0);  // d4 d4 d5 d5 ...
+            const __m128i d0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(dr + 2 * x));
+            const __m128i d1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(dr + 2 * x + 8));
+            const __m128i g0 = _mm_unpacklo_epi16(d0, d1), g1 = _mm_unpackhi_epi16(d0, d1);
+            const __m128i e0 = _mm_unpacklo_epi16(diff2, diff1);
+            const __m128i e1 = _mm_unpackhi_epi16(diff2, diff1);
+            qb0 = _mm_add_ps(qb0, _mm_cvtepi32_ps(_mm_madd_epi16(e0, g0)));
+            qb1 = _mm_add_ps(qb1, _mm_cvtepi32_ps(_mm_madd_epi16(e1, g1)));
+#else
+            int d[8];
+            for (int t = 0; t < 8; ++t)
+                d[t] = descale(j0[x + t] * v.w00 + j0[x + t + 1] * v.w01 + j1[x + t] * v.w10 +
+                                   j1[x + t + 1] * v.w11, kWBits - 5) - ir[x + t];
+            const std::int16_t* g = dr + 2 * x;
+            for (int u = 0; u < 2; ++u) {
+                const int a = u, b = 2 + u;  // pixels of qb0 and of qb1
+                q0[2 * u] += static_cast<float>(d[a] * g[2 * a] + d[a + 4] * g[2 * a + 8]);
+                q0[2 * u + 1] += static_cast<float>(d[a] * g[2 * a + 1] + d[a + 4] * g[2 * a + 9]);
+                q1[2 * u] += static_cast<float>(d[b] * g[2 * b] + d[b + 4] * g[2 * b + 8]);
+                q1[2 * u + 1] += static_cast<float>(d[b] * g[2 * b + 1] + d[b + 4] * g[2 * b + 9]);
+            }
+#endif
+        }
+        for (; x < win_w; ++x) {
+            const int d = descale(j0[x] * v.w00 + j0[x + 1] * v.w01 + j1[x] * v.w10 +
+                                      j1[x + 1] * v.w11, kWBits - 5) - ir[x];
+            b1 += static_cast<float>(d * dr[2 * x]);
+            b2 += static_cast<float>(d * dr[2 * x + 1]);
+        }
     }
-    const int n = img.rows, m = img.cols;
-    const int ru = r > 0 ? r - 1 : (n > 1 ? 1 : 0), rd = r < n - 1 ? r + 1 : (n > 1 ? n - 2 : 0);
-    const int cl = c > 0 ? c - 1 : (m > 1 ? 1 : 0), cr = c < m - 1 ? c + 1 : (m > 1 ? m - 2 : 0);
-    const std::uint8_t *u = img.row(ru), *o = img.row(r), *d = img.row(rd);
-    // smoothed across rows (3, 10, 3), then differenced across columns, and the other way round
-    const int sl = 3 * (u[cl] + d[cl]) + 10 * o[cl], sr = 3 * (u[cr] + d[cr]) + 10 * o[cr];
-    const int tl = d[cl] - u[cl], tc = d[c] - u[c], tr = d[cr] - u[cr];
-    dx = sr - sl;
-    dy = 3 * (tl + tr) + 10 * tc;
+#if defined(__SSE2__)
+    _mm_storeu_ps(s, _mm_add_ps(qb0, qb1));
+#else
+    for (int k = 0; k < 4; ++k) s[k] = q0[k] + q1[k];
+#endif
 }
+
+#if defined(__SSE2__)
+/// The window's lanes of Ix Ix, Ix Iy and Iy Iy (OpenCV's qA11, qA12, qA22).
+struct Lanes {
+    __m128 a11 = _mm_setzero_ps(), a12 = _mm_setzero_ps(), a22 = _mm_setzero_ps();
+};
+
+/// Eight columns of a row of the previous window, as OpenCV's SSE loop makes them: the pixels'
+/// bilinear values (s0, s1: this row and the next, bytes) descaled to 1/32 into `iv`, the
+/// derivatives' (g0, g1: Ix, Iy pairs) descaled into `dv`, and their products added to the
+/// lanes, pixels 0-3 then 4-7 (lane k: pixel k, then k + 4).
+inline void window_block(const std::uint8_t* s0, const std::uint8_t* s1, const std::int16_t* g0,
+                         const std::int16_t* g1, const Weights& w, std::int16_t* iv,
+                         std::int16_t* dv, Lanes& lanes) {
+    const __m128i z = _mm_setzero_si128();
+    const auto pair = [](int lo, int hi) {
+        return _mm_set1_epi32(static_cast<int>((static_cast<unsigned>(hi) << 16) |
+                                               (static_cast<unsigned>(lo) & 0xffffu)));
+    };
+    const __m128i qw0 = pair(w.w00, w.w01), qw1 = pair(w.w10, w.w11);
+    const __m128i qdelta = _mm_set1_epi32(1 << (kWBits - 5 - 1));
+    const __m128i qdelta_d = _mm_set1_epi32(1 << (kWBits - 1));
+    const auto ld8 = [&](const std::uint8_t* q) {
+        return _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(q)), z);
+    };
+    const auto ld16 = [](const std::int16_t* q) {
+        return _mm_loadu_si128(reinterpret_cast<const __m128i*>(q));
+    };
+    const __m128i v00 = ld8(s0), v01 = ld8(s0 + 1), v10 = ld8(s1), v11 = ld8(s1 + 1);
+    __m128i t0 = _mm_add_epi32(
+        _mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi16(v00, v01), qw0), qdelta),
+        _mm_madd_epi16(_mm_unpacklo_epi16(v10, v11), qw1));
+    __m128i t1 = _mm_add_epi32(
+        _mm_add_epi32(_mm_madd_epi16(_mm_unpackhi_epi16(v00, v01), qw0), qdelta),
+        _mm_madd_epi16(_mm_unpackhi_epi16(v10, v11), qw1));
+    t0 = _mm_srai_epi32(t0, kWBits - 5);
+    t1 = _mm_srai_epi32(t1, kWBits - 5);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(iv), _mm_packs_epi32(t0, t1));
+    for (int half = 0; half < 2; ++half) {
+        const int o = 8 * half;  // int16 offset of pixels 4-7
+        const __m128i d00 = ld16(g0 + o), d01 = ld16(g0 + o + 2);
+        const __m128i d10 = ld16(g1 + o), d11 = ld16(g1 + o + 2);
+        __m128i u0 = _mm_add_epi32(
+            _mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi16(d00, d01), qw0), qdelta_d),
+            _mm_madd_epi16(_mm_unpacklo_epi16(d10, d11), qw1));
+        __m128i u1 = _mm_add_epi32(
+            _mm_add_epi32(_mm_madd_epi16(_mm_unpackhi_epi16(d00, d01), qw0), qdelta_d),
+            _mm_madd_epi16(_mm_unpackhi_epi16(d10, d11), qw1));
+        const __m128i g = _mm_packs_epi32(_mm_srai_epi32(u0, kWBits), _mm_srai_epi32(u1, kWBits));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(dv + o), g);  // Ix0 Iy0 Ix1 Iy1 ...
+        const __m128 fy = _mm_cvtepi32_ps(_mm_srai_epi32(g, 16));
+        const __m128 fx = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(g, 16), 16));
+        lanes.a22 = _mm_add_ps(lanes.a22, _mm_mul_ps(fy, fy));
+        lanes.a12 = _mm_add_ps(lanes.a12, _mm_mul_ps(fx, fy));
+        lanes.a11 = _mm_add_ps(lanes.a11, _mm_mul_ps(fx, fx));
+    }
+}
+#endif
+
+#if defined(__SSE2__)
+/// Scharr derivatives of 12 pixels of a row inside the image, as calcScharrDeriv's: `u`, `o`,
+/// `d` point at the column left of the first pixel in the rows above, at and below it (14
+/// columns read); writes 12 (Ix, Iy) pairs to `g`. Integers, exact in int16.
+inline void scharr_row_12(const std::uint8_t* u, const std::uint8_t* o, const std::uint8_t* d,
+                          std::int16_t* g) {
+    const __m128i z = _mm_setzero_si128(), c3 = _mm_set1_epi16(3), c10 = _mm_set1_epi16(10);
+    alignas(16) std::int16_t t0[16], t1[16];
+    for (int c0 : {0, 6}) {  // columns 0-7 and 6-13
+        const auto ld = [&](const std::uint8_t* q) {
+            return _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(q + c0)), z);
+        };
+        const __m128i a = ld(u), m = ld(o), b = ld(d);
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(t0 + c0),
+                         _mm_add_epi16(_mm_mullo_epi16(_mm_add_epi16(a, b), c3),
+                                       _mm_mullo_epi16(m, c10)));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(t1 + c0), _mm_sub_epi16(b, a));
+    }
+    for (int x0 : {0, 4}) {  // pixels 0-7 and 4-11
+        const auto ld = [](const std::int16_t* q) {
+            return _mm_loadu_si128(reinterpret_cast<const __m128i*>(q));
+        };
+        const __m128i gx = _mm_sub_epi16(ld(t0 + x0 + 2), ld(t0 + x0));
+        const __m128i gy = _mm_add_epi16(
+            _mm_mullo_epi16(_mm_add_epi16(ld(t1 + x0), ld(t1 + x0 + 2)), c3),
+            _mm_mullo_epi16(ld(t1 + x0 + 1), c10));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(g + 2 * x0), _mm_unpacklo_epi16(gx, gy));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(g + 2 * x0 + 8), _mm_unpackhi_epi16(gx, gy));
+    }
+}
+#endif
 
 }  // namespace flow_detail
 
@@ -93,13 +251,28 @@ inline void still_flow(const GreyImage& prev, const GreyImage& next, const float
     const double eps2 = epsilon * epsilon;
     const int area = win_w * win_h;
     const int simd_w = (win_w / 8) * 8;  // columns summed in four lanes
-    std::vector<int> ival(static_cast<std::size_t>(area)), ix(ival.size()), iy(ival.size());
-    std::vector<int> dxs(static_cast<std::size_t>((win_w + 1) * (win_h + 1))), dys(dxs.size());
-    std::vector<const std::uint8_t*> rowp(static_cast<std::size_t>(win_h + 1));
-    std::vector<int> colx(static_cast<std::size_t>(win_w + 1));
-    const auto window = [&](const GreyImage& img, int x0, int y0) {
-        for (int y = 0; y <= win_h; ++y) rowp[y] = img.row(reflect_101(y0 + y, img.rows));
-        for (int x = 0; x <= win_w; ++x) colx[x] = reflect_101(x0 + x, img.cols);
+    const int bw = win_w + 1;            // a window's columns with the bilinear neighbour
+    const int bs = (bw + 8 + 15) / 16 * 16;  // bytes a row of a copied window (room to load 8)
+    const int ws = simd_w + 8 + (win_w - simd_w);  // int16 a row of the window's values
+    std::vector<std::uint8_t> ibuf(static_cast<std::size_t>((win_h + 1) * bs), 0), jbuf(ibuf);
+    std::vector<std::int16_t> deriv(static_cast<std::size_t>((win_h + 1) * bw * 2));
+    std::vector<std::int16_t> ival(static_cast<std::size_t>(win_h * ws), 0);
+    std::vector<std::int16_t> dval(static_cast<std::size_t>(win_h * ws * 2), 0);
+    std::vector<int> t0(static_cast<std::size_t>(bw + 2)), t1(t0.size());
+    const int ps = bw + 2 + 8;  // bytes a row of an edge window's neighbourhood (room to load 8)
+    std::vector<std::uint8_t> patch(static_cast<std::size_t>((win_h + 3) * ps), 0);
+    // the window's pixels (win_h + 1 rows of bw) at (x0, y0), reflected beyond the edges
+    const auto copy_window = [&](const GreyImage& img, int x0, int y0, std::uint8_t* buf) {
+        const bool inside = x0 >= 0 && x0 + bw <= img.cols;
+        for (int y = 0; y <= win_h; ++y) {
+            const std::uint8_t* row = img.row(reflect_101(y0 + y, img.rows));
+            std::uint8_t* dst = buf + y * bs;
+            if (inside) {
+                for (int x = 0; x < bw; ++x) dst[x] = row[x0 + x];
+            } else {
+                for (int x = 0; x < bw; ++x) dst[x] = row[reflect_101(x0 + x, img.cols)];
+            }
+        }
     };
     for (int p = 0; p < n; ++p) {
         status[p] = 1;
@@ -115,29 +288,77 @@ inline void still_flow(const GreyImage& prev, const GreyImage& next, const float
             continue;
         }
         const Weights w(px - static_cast<float>(ipx), py - static_cast<float>(ipy));
-        window(prev, ipx, ipy);
-        for (int y = 0; y <= win_h; ++y)
-            for (int x = 0; x <= win_w; ++x)
-                scharr_at(prev, ipy + y, ipx + x, dxs[y * (win_w + 1) + x], dys[y * (win_w + 1) + x]);
+        copy_window(prev, ipx, ipy, ibuf.data());
+        // Scharr derivatives of the window's cells, rows smoothed (3, 10, 3) and differenced
+        // down, then across columns. Inside the image the rows are read in place; a window at
+        // an edge reads a copy of its neighbourhood reflected as calcScharrDeriv reflects
+        // (-1 -> 1, n -> n - 2: BORDER_REFLECT_101), and its cells outside the image are 0.
+        const bool inside =
+            ipx >= 1 && ipx + bw < prev.cols && ipy >= 1 && ipy + win_h + 1 < prev.rows;
+        if (!inside) {
+            for (int y = 0; y < win_h + 3; ++y) {
+                const std::uint8_t* row = prev.row(reflect_101(ipy - 1 + y, prev.rows));
+                std::uint8_t* dst = &patch[static_cast<std::size_t>(y * ps)];
+                for (int c = 0; c < bw + 2; ++c) dst[c] = row[reflect_101(ipx - 1 + c, prev.cols)];
+            }
+        }
+        for (int y = 0; y <= win_h; ++y) {
+            const std::uint8_t* u = inside ? prev.row(ipy + y - 1) + ipx - 1
+                                           : &patch[static_cast<std::size_t>(y * ps)];
+            const std::uint8_t* o = inside ? u + prev.stride : u + ps;
+            const std::uint8_t* d = inside ? o + prev.stride : o + ps;
+            std::int16_t* g = &deriv[static_cast<std::size_t>(y * bw * 2)];
+#if defined(__SSE2__)
+            if (bw == 12) {  // the 11 x 11 window: 14 columns in two loads of 8
+                scharr_row_12(u, o, d, g);
+            } else
+#endif
+            {
+                for (int c = 0; c < bw + 2; ++c) {
+                    t0[c] = 3 * (u[c] + d[c]) + 10 * o[c];
+                    t1[c] = d[c] - u[c];
+                }
+                for (int x = 0; x < bw; ++x) {
+                    g[2 * x] = static_cast<std::int16_t>(t0[x + 2] - t0[x]);
+                    g[2 * x + 1] =
+                        static_cast<std::int16_t>(3 * (t1[x] + t1[x + 2]) + 10 * t1[x + 1]);
+                }
+            }
+            if (!inside) {
+                const int r = ipy + y;
+                for (int x = 0; x < bw; ++x) {
+                    const int c = ipx + x;
+                    if (r < 0 || r >= prev.rows || c < 0 || c >= prev.cols)
+                        g[2 * x] = g[2 * x + 1] = 0;
+                }
+            }
+        }
         float a11 = 0, a12 = 0, a22 = 0;   // the tail columns, one by one
         float l11[4] = {0, 0, 0, 0}, l12[4] = {0, 0, 0, 0}, l22[4] = {0, 0, 0, 0};  // the lanes
+#if defined(__SSE2__)
+        Lanes lanes;
+#endif
         for (int y = 0; y < win_h; ++y) {
-            const std::uint8_t *s0 = rowp[y], *s1 = rowp[y + 1];
-            const int* dx0 = &dxs[y * (win_w + 1)];
-            const int* dy0 = &dys[y * (win_w + 1)];
-            const int* dx1 = dx0 + (win_w + 1);
-            const int* dy1 = dy0 + (win_w + 1);
-            for (int x = 0; x < win_w; ++x) {
-                const int k = y * win_w + x;
-                ival[k] = descale(s0[colx[x]] * w.w00 + s0[colx[x + 1]] * w.w01 +
-                                      s1[colx[x]] * w.w10 + s1[colx[x + 1]] * w.w11,
-                                  kWBits - 5);
-                const int gx = descale(dx0[x] * w.w00 + dx0[x + 1] * w.w01 + dx1[x] * w.w10 +
-                                           dx1[x + 1] * w.w11, kWBits);
-                const int gy = descale(dy0[x] * w.w00 + dy0[x + 1] * w.w01 + dy1[x] * w.w10 +
-                                           dy1[x + 1] * w.w11, kWBits);
-                ix[k] = gx;
-                iy[k] = gy;
+            const std::uint8_t *s0 = &ibuf[static_cast<std::size_t>(y * bs)], *s1 = s0 + bs;
+            const std::int16_t* g0 = &deriv[static_cast<std::size_t>(y * bw * 2)];
+            const std::int16_t* g1 = g0 + bw * 2;
+            std::int16_t* iv = &ival[static_cast<std::size_t>(y * ws)];
+            std::int16_t* dv = &dval[static_cast<std::size_t>(y * ws * 2)];
+            int x0 = 0;
+#if defined(__SSE2__)
+            for (; x0 < simd_w; x0 += 8) window_block(s0 + x0, s1 + x0, g0 + 2 * x0, g1 + 2 * x0,
+                                                      w, iv + x0, dv + 2 * x0, lanes);
+#endif
+            for (int x = x0; x < win_w; ++x) {
+                iv[x] = static_cast<std::int16_t>(descale(
+                    s0[x] * w.w00 + s0[x + 1] * w.w01 + s1[x] * w.w10 + s1[x + 1] * w.w11,
+                    kWBits - 5));
+                const int gx = descale(g0[2 * x] * w.w00 + g0[2 * x + 2] * w.w01 +
+                                           g1[2 * x] * w.w10 + g1[2 * x + 2] * w.w11, kWBits);
+                const int gy = descale(g0[2 * x + 1] * w.w00 + g0[2 * x + 3] * w.w01 +
+                                           g1[2 * x + 1] * w.w10 + g1[2 * x + 3] * w.w11, kWBits);
+                dv[2 * x] = static_cast<std::int16_t>(gx);
+                dv[2 * x + 1] = static_cast<std::int16_t>(gy);
                 // products below 2^24: exact in float; only the sums' order rounds
                 const float fx = static_cast<float>(gx), fy = static_cast<float>(gy);
                 if (x < simd_w) {
@@ -152,6 +373,11 @@ inline void still_flow(const GreyImage& prev, const GreyImage& next, const float
                 }
             }
         }
+#if defined(__SSE2__)
+        _mm_storeu_ps(l11, lanes.a11);
+        _mm_storeu_ps(l12, lanes.a12);
+        _mm_storeu_ps(l22, lanes.a22);
+#endif
         // the lanes summed as OpenCV's v_reduce_sum on SSE does: (l0 + l2) + (l1 + l3)
         a11 += (l11[0] + l11[2]) + (l11[1] + l11[3]);
         a12 += (l12[0] + l12[2]) + (l12[1] + l12[3]);
@@ -175,47 +401,13 @@ inline void still_flow(const GreyImage& prev, const GreyImage& next, const float
                 break;
             }
             const Weights v(nx - static_cast<float>(inx), ny - static_cast<float>(iny));
-            window(next, inx, iny);
+            copy_window(next, inx, iny, jbuf.data());
             float b1 = 0, b2 = 0;
-            float q0[4] = {0, 0, 0, 0}, q1[4] = {0, 0, 0, 0};  // OpenCV's qb0, qb1
-            for (int y = 0; y < win_h; ++y) {
-                const std::uint8_t *j0 = rowp[y], *j1 = rowp[y + 1];
-                const int* iv = &ival[y * win_w];
-                const int* gx = &ix[y * win_w];
-                const int* gy = &iy[y * win_w];
-                int diff[8];
-                for (int x0 = 0; x0 < simd_w; x0 += 8) {
-                    for (int t = 0; t < 8; ++t) {
-                        const int x = x0 + t;
-                        diff[t] = descale(j0[colx[x]] * v.w00 + j0[colx[x + 1]] * v.w01 +
-                                              j1[colx[x]] * v.w10 + j1[colx[x + 1]] * v.w11,
-                                          kWBits - 5) - iv[x];
-                    }
-                    // pairs (t, t + 4) summed as int32 (exact), then to float, in lanes
-                    // [x of t, y of t, x of t+1, y of t+1] for t = 0 (q0) and t = 2 (q1)
-                    for (int h = 0; h < 2; ++h) {
-                        float* q = h == 0 ? q0 : q1;
-                        for (int u = 0; u < 2; ++u) {
-                            const int t = 2 * h + u, x = x0 + t;
-                            q[2 * u] += static_cast<float>(diff[t] * gx[x] + diff[t + 4] * gx[x + 4]);
-                            q[2 * u + 1] +=
-                                static_cast<float>(diff[t] * gy[x] + diff[t + 4] * gy[x + 4]);
-                        }
-                    }
-                }
-                for (int x = simd_w; x < win_w; ++x) {
-                    const int d = descale(j0[colx[x]] * v.w00 + j0[colx[x + 1]] * v.w01 +
-                                              j1[colx[x]] * v.w10 + j1[colx[x + 1]] * v.w11,
-                                          kWBits - 5) - iv[x];
-                    b1 += static_cast<float>(d * gx[x]);
-                    b2 += static_cast<float>(d * gy[x]);
-                }
-            }
-            // OpenCV: s = qb0 + qb1; b1 += s0 + s2, b2 += s1 + s3
-            const float s0 = q0[0] + q1[0], s1 = q0[1] + q1[1], s2 = q0[2] + q1[2],
-                        s3 = q0[3] + q1[3];
-            b1 += s0 + s2;
-            b2 += s1 + s3;
+            float s[4] = {0, 0, 0, 0};  // OpenCV's qb0 + qb1, lane by lane
+            sums_of_window(jbuf.data(), bs, ival.data(), dval.data(), ws, win_w, win_h, simd_w,
+                           v, s, b1, b2);
+            b1 += s[0] + s[2];
+            b2 += s[1] + s[3];
             b1 *= kFltScale;
             b2 *= kFltScale;
             const float ddx = (A12 * b2 - A22 * b1) * det;
