@@ -1,6 +1,8 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -34,7 +36,13 @@ int point_count(const PointsF32& pts, const char* fn, const char* what) {
     const bool ok = (pts.ndim() == 2 && pts.shape(1) == 2) ||
                     (pts.ndim() == 3 && pts.shape(1) == 1 && pts.shape(2) == 2);
     if (!ok) fail(fn, std::string(what) + " must have shape (N, 2) or (N, 1, 2)");
-    return static_cast<int>(pts.shape(0));
+    const int n = static_cast<int>(pts.shape(0));
+    const float* v = pts.data();
+    for (int i = 0; i < 2 * n; ++i)  // the flow converts coordinates to int: keep them in range
+        if (!(std::abs(v[i]) <= 1e8f))
+            fail(fn, std::string(what) + " must be finite and within 1e8 (got " +
+                         std::to_string(v[i]) + ")");
+    return n;
 }
 
 }  // namespace
@@ -43,15 +51,17 @@ void register_camera(py::module_& m) {
     m.def(
         "still_flow",
         [](const py::object& prev_in, const py::object& next_in, const PointsF32& pts,
-           int win_size, int max_count, double epsilon, float min_eig) {
+           int win_size, int max_count, double epsilon, double min_eig) {
             const char* fn = "still_flow";
             py::array prev_keep, next_keep;
             const GreyImage prev = grey_image(prev_in, fn, "prev", prev_keep);
             const GreyImage next = grey_image(next_in, fn, "next", next_keep);
             if (prev.rows != next.rows || prev.cols != next.cols)
                 fail(fn, "prev and next differ in size");
-            require(win_size >= 3, fn, "win_size", win_size, ">= 3");
-            require(max_count >= 0, fn, "max_count", max_count, ">= 0");
+            require(win_size >= 3 && win_size <= 255, fn, "win_size", win_size, "in [3, 255]");
+            // as OpenCV reads its criteria: at most 100 steps, epsilon in [0, 10]
+            max_count = std::min(std::max(max_count, 0), 100);
+            epsilon = std::min(std::max(epsilon, 0.0), 10.0);
             const int n = point_count(pts, fn, "pts");
             py::array_t<float> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(2)});
             py::array_t<bool> ok(n);
@@ -59,12 +69,12 @@ void register_camera(py::module_& m) {
                 py::gil_scoped_release nogil;  // safe: plain buffers kept alive above
                 still_flow(prev, next, pts.data(), n, out.mutable_data(),
                            reinterpret_cast<std::uint8_t*>(ok.mutable_data()), win_size,
-                           win_size, max_count, epsilon, min_eig);
+                           win_size, max_count, epsilon, static_cast<float>(min_eig));
             }
             return std::make_pair(out, ok);
         },
         py::arg("prev"), py::arg("next"), py::arg("pts"), py::arg("win_size") = 11,
-        py::arg("max_count") = 30, py::arg("epsilon") = 0.01, py::arg("min_eig") = 1e-4f,
+        py::arg("max_count") = 30, py::arg("epsilon") = 0.01, py::arg("min_eig") = 1e-4,
         "Lucas-Kanade flow at one level of pts (N, 2) float32 of grey prev (H, W) uint8 into "
         "next: places (N, 2) float32 and followed (N,) bool, OpenCV's to the bit.");
     m.def(

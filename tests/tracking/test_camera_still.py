@@ -120,8 +120,12 @@ def test_still_flow_refuses_bad_input_in_one_line() -> None:
         _core.still_flow(g, g, np.zeros((3, 3), np.float32))
     with pytest.raises(ValueError, match="packed along rows"):
         _core.still_flow(g[:, ::2], g[:, ::2], pts)
-    with pytest.raises(ValueError, match="win_size is 2, expected >= 3"):
+    with pytest.raises(ValueError, match=r"win_size is 2, expected in \[3, 255\]"):
         _core.still_flow(g, g, pts, win_size=2)
+    with pytest.raises(ValueError, match="pts must be finite and within 1e8"):
+        _core.still_flow(g, g, np.array([[1.0, np.nan]], np.float32))
+    with pytest.raises(ValueError, match="pts must be finite and within 1e8"):
+        _core.still_flow(g, g, np.array([[1e9, 2.0]]))
     nxt, ok = _core.still_flow(g, g, np.zeros((0, 2), np.float32))  # no points: nothing
     assert nxt.shape == (0, 2) and ok.shape == (0,)
 
@@ -157,6 +161,8 @@ def test_similarity_fit_of_points_without_spread_is_none() -> None:
     assert _core.similarity_fit(same[:1], same[:1]) is None
     with pytest.raises(ValueError, match="differ in length"):
         _core.similarity_fit(same, same[:4])
+    with pytest.raises(ValueError, match="dst must be finite"):
+        _core.similarity_fit(same, np.full((5, 2), np.inf, np.float32))
 
 
 def _opencv_follow_still(

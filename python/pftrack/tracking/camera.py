@@ -15,8 +15,9 @@ slows down, its small motion is still applied). While it does not move the trans
 back is None and nothing is changed, so a still camera tracks exactly as without compensation.
 While it is still, the measurement is cheap: the last corners found are followed from frame to
 frame (at most ``CameraConfig.still_features``, no new corner search, and on the scaled frame
-alone, without the flow's image pyramid), and a frame is measured in full only when that finds
-motion near the threshold or too few inliers, or the corners are ``refresh_frames`` old.
+alone, without the flow's image pyramid, by the core's copy of OpenCV's flow that computes the
+derivatives in the corners' windows only), and a frame is measured in full only when that
+finds motion near the threshold or too few inliers, or the corners are ``refresh_frames`` old.
 
 :func:`warp_tracks` applies a transform to the tracker's state: every particle (its current and
 previous centre, the AR(2) state; the scale through the filter's base size), the particle-set
