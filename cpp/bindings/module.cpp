@@ -19,6 +19,7 @@ void register_text(py::module_& m);
 void register_regions(py::module_& m);
 void register_tracks(py::module_& m);
 void register_overlap(py::module_& m);
+void register_camera(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "pftrack's C++ kernels (private: use the pftrack package)";
@@ -37,4 +38,5 @@ PYBIND11_MODULE(_core, m) {
     register_regions(m);
     register_tracks(m);
     register_overlap(m);
+    register_camera(m);
 }

@@ -620,3 +620,15 @@ def region_blocks(
     work: int,
     decimals: int,
 ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]: ...
+
+# --- the still camera's measurement (camera.hpp): grey (H, W) uint8; points (N, 2) or (N, 1, 2) --
+def still_flow(
+    prev: NDArray[np.uint8],
+    next: NDArray[np.uint8],
+    pts: ArrayLike,
+    win_size: int = 11,
+    max_count: int = 30,
+    epsilon: float = 0.01,
+    min_eig: float = 1e-4,
+) -> tuple[NDArray[np.float32], NDArray[np.bool_]]: ...  # places (N, 2), followed (N,)
+def similarity_fit(src: ArrayLike, dst: ArrayLike) -> _F64 | None: ...  # (2, 3)

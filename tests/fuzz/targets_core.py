@@ -259,6 +259,30 @@ def _overlap_pairs() -> st.SearchStrategy[Any]:
     return call(_core.overlap_pairs, maybe(boxes()), maybe(boxes()))
 
 
+def _still_flow() -> st.SearchStrategy[Any]:
+    def grey(h: int, w: int) -> st.SearchStrategy[Any]:
+        return hnp.arrays(np.uint8, (h, w)).flatmap(layout)
+
+    return st.tuples(st.integers(1, 24), st.integers(1, 24), N).flatmap(
+        lambda hwn: call(
+            _core.still_flow,
+            maybe(grey(hwn[0], hwn[1])),
+            maybe(grey(hwn[0], hwn[1])),
+            maybe(floats_array((hwn[2], 2), -30, 60)),
+        )
+    )
+
+
+def _similarity_fit() -> st.SearchStrategy[Any]:
+    return N.flatmap(
+        lambda n: call(
+            _core.similarity_fit,
+            maybe(floats_array((n, 2), -1e3, 1e3)),
+            maybe(floats_array((n, 2), -1e3, 1e3)),
+        )
+    )
+
+
 def _padded_assignment() -> st.SearchStrategy[Any]:
     return st.tuples(N, N).flatmap(
         lambda td: call(
@@ -666,6 +690,8 @@ TARGETS: list[Target] = [
     Target("sparse_assignment", _sparse_assignment()),
     Target("overlap_pairs", _overlap_pairs()),
     Target("padded_assignment", _padded_assignment()),
+    Target("still_flow", _still_flow()),
+    Target("similarity_fit", _similarity_fit()),
     Target(
         "refine_boxes",
         call(

@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 import pytest
 
+from pftrack import _core
 from pftrack.io.mot import group_by_frame
 from pftrack.synthetic import Scene, camera_path, make_scene, move_camera, warp_frame
 from pftrack.tracking import (
@@ -186,7 +187,13 @@ def _record_pyramid_levels(monkeypatch: pytest.MonkeyPatch) -> list[int]:
         levels.append(kwargs["maxLevel"])
         return flow(*args, **kwargs)
 
+    def still(*args: Any, **kwargs: Any) -> Any:
+        levels.append(0)  # the core's flow at one level (OpenCV's with maxLevel=0, to the bit)
+        return still_flow(*args, **kwargs)
+
+    still_flow = _core.still_flow
     monkeypatch.setattr(cv2, "calcOpticalFlowPyrLK", recorded)
+    monkeypatch.setattr(_core, "still_flow", still)
     return levels
 
 

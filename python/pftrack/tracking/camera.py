@@ -15,8 +15,9 @@ slows down, its small motion is still applied). While it does not move the trans
 back is None and nothing is changed, so a still camera tracks exactly as without compensation.
 While it is still, the measurement is cheap: the last corners found are followed from frame to
 frame (at most ``CameraConfig.still_features``, no new corner search, and on the scaled frame
-alone, without the flow's image pyramid), and a frame is measured in full only when that finds
-motion near the threshold or too few inliers, or the corners are ``refresh_frames`` old.
+alone, without the flow's image pyramid, by the core's copy of OpenCV's flow that computes the
+derivatives in the corners' windows only), and a frame is measured in full only when that
+finds motion near the threshold or too few inliers, or the corners are ``refresh_frames`` old.
 
 :func:`warp_tracks` applies a transform to the tracker's state: every particle (its current and
 previous centre, the AR(2) state; the scale through the filter's base size), the particle-set
@@ -43,6 +44,7 @@ import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pftrack import _core
 from pftrack._check import bgr_array, option
 from pftrack._typing import F64
 from pftrack.tracking.config import CAMERA_MOTION, CameraConfig
@@ -274,6 +276,54 @@ class _Measure:
         a[:, 2] /= factor  # scaled pixels -> frame pixels (the linear part is the same)
         return a, np.ascontiguousarray(dst[inliers].reshape(-1, 1, 2))
 
+    def follow_still(
+        self, prev: NDArray[np.uint8], cur: NDArray[np.uint8], pts: NDArray[np.float32],
+        factor: float, size: tuple[int, int], below: float,
+    ) -> tuple[F64, float, NDArray[np.float32]] | None:  # fmt: skip
+        """:meth:`follow` on the scaled frames alone (:data:`STILL_LEVELS`), for a still camera.
+
+        The corners are followed by ``_core.still_flow``, OpenCV's Lucas-Kanade of
+        :func:`_flow` at one level to the bit, computing the image derivatives only in the
+        corners' windows (OpenCV makes them for the whole frame). RANSAC chooses the inliers as
+        in :meth:`fit`; when the transform of its inliers' least squares, in closed form
+        (``_core.similarity_fit``), moves the image by less than `below` pixels (less a margin,
+        :data:`STILL_MARGIN`), it is taken instead of OpenCV's Levenberg-Marquardt refinement
+        of the same least squares, which stops short of that minimum (by up to 3e-5 px of the
+        image corners' motion on PETS09 and TUD-Campus). Otherwise (a frame near or over
+        `below`, or a degenerate fit) the transform is :meth:`fit`'s, refined as before. So
+        every decision taken on a still frame and every transform applied is as before; only
+        the reported ``CameraStep.affine`` and
+        ``magnitude`` of a frame that stays under `below` differ: they are the least squares'
+        minimum itself, where OpenCV's were a few 1e-5 px short of it.
+
+        Returns the transform (frame pixels), its :func:`motion_magnitude` and the inlier
+        corners' places in `cur` (N, 1, 2), or None (too few corners followed or inliers).
+        """
+        cfg = self.config
+        nxt, ok = _core.still_flow(prev, cur, pts)
+        src, dst = pts.reshape(-1, 2)[ok], nxt[ok]
+        if len(src) < cfg.min_inliers:
+            return None
+        m, inliers = cv2.estimateAffinePartial2D(
+            src, dst, method=cv2.RANSAC, ransacReprojThreshold=cfg.ransac_threshold,
+            maxIters=2000, confidence=0.995, refineIters=0,
+        )  # fmt: skip
+        if m is None or inliers is None or np.count_nonzero(inliers) < cfg.min_inliers:
+            return None
+        kept = inliers.reshape(-1) == 1
+        a: F64 | None = _core.similarity_fit(src[kept], dst[kept])
+        magnitude = 0.0
+        if a is not None:
+            a[:, 2] /= factor  # scaled pixels -> frame pixels (the linear part is the same)
+            magnitude = motion_magnitude(a, size)
+        if a is None or magnitude >= below - STILL_MARGIN:
+            a, _ = self.fit(src, dst)  # the same RANSAC draws: the same inliers
+            if a is None:
+                return None
+            a[:, 2] /= factor
+            magnitude = motion_magnitude(a, size)
+        return a, magnitude, np.ascontiguousarray(dst[kept].reshape(-1, 1, 2))
+
     def follow_key(
         self, key: NDArray[np.uint8], cur: NDArray[np.uint8], pts: NDArray[np.float32], guess: F64
     ) -> tuple[F64, NDArray[np.float32], NDArray[np.bool_]] | None:
@@ -315,6 +365,12 @@ KEY_INLIERS = 0.75
 #: lost and the frame is measured in full, with the pyramid, so a jump is never taken for a
 #: still frame. The flow takes 0.06 instead of 0.15 ms on 40 corners (one OpenCV thread).
 STILL_LEVELS = 0
+#: Pixels below the still camera's thresholds under which a still frame's transform may be the
+#: closed-form least squares instead of OpenCV's refined one (:meth:`_Measure.follow_still`).
+#: OpenCV's Levenberg-Marquardt stops short of the minimum: the two motions differed by at most
+#: 2.9e-5 px over the still frames of PETS09 and TUD-Campus (docs/results.md, stop 72), 1/350
+#: of this margin.
+STILL_MARGIN = 0.01
 
 
 @dataclass
@@ -523,10 +579,11 @@ class CameraMotion:
             or self._corner_age >= cfg.refresh_frames
         ):
             return None
-        affine, kept = self._measure.follow(prev, grey, corners, factor, STILL_LEVELS)
-        if affine is None:
+        below = min(cfg.still_threshold, 0.5 * cfg.threshold) * diagonal
+        followed = self._measure.follow_still(prev, grey, corners, factor, size, below)
+        if followed is None:
             return None
-        magnitude = motion_magnitude(affine, size)
+        affine, magnitude, kept = followed
         if magnitude >= 0.5 * cfg.threshold * diagonal:
             return None
         self._corners, self._corner_age = kept, self._corner_age + 1
