@@ -56,6 +56,29 @@ struct Weights {
     }
 };
 
+#if defined(__SSE2__)
+/// Two int16 weights (lo, hi) in every 32-bit lane, for `_mm_madd_epi16` of (left, right) pairs.
+inline __m128i weight_pair(int lo, int hi) {
+    return _mm_set1_epi32(static_cast<int>((static_cast<unsigned>(hi) << 16) |
+                                           (static_cast<unsigned>(lo) & 0xffffu)));
+}
+
+/// Eight bilinear values of 16-bit pixels (v00, v01: a row and its right neighbours; v10, v11:
+/// the next row's) with the weight pairs `qw0`, `qw1`, rounded by `qdelta` and shifted right by
+/// `shift`: OpenCV's SSE2 steps, in its order, packed to int16.
+inline __m128i bilinear8(__m128i v00, __m128i v01, __m128i v10, __m128i v11, __m128i qw0,
+                         __m128i qw1, __m128i qdelta, int shift) {
+    const __m128i t0 = _mm_add_epi32(
+        _mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi16(v00, v01), qw0), qdelta),
+        _mm_madd_epi16(_mm_unpacklo_epi16(v10, v11), qw1));
+    const __m128i t1 = _mm_add_epi32(
+        _mm_add_epi32(_mm_madd_epi16(_mm_unpackhi_epi16(v00, v01), qw0), qdelta),
+        _mm_madd_epi16(_mm_unpackhi_epi16(v10, v11), qw1));
+    const __m128i c = _mm_cvtsi32_si128(shift);
+    return _mm_packs_epi32(_mm_sra_epi32(t0, c), _mm_sra_epi32(t1, c));
+}
+#endif
+
 /// One step's mismatch sums of a window: J, the next image's window (win_h + 1 rows of `bs`
 /// bytes), bilinear at weights `v`, less the previous window's values `iv` (int16, rows of
 /// `ws`), times its derivatives `dv` (Ix, Iy pairs, rows of 2 ws). The first `simd_w` columns
@@ -68,11 +91,7 @@ inline void sums_of_window(const std::uint8_t* jb, int bs, const std::int16_t* i
                            const Weights& v, float* s, float& b1, float& b2) {
 #if defined(__SSE2__)
     const __m128i z = _mm_setzero_si128();
-    const auto pair = [](int lo, int hi) {
-        return _mm_set1_epi32(static_cast<int>((static_cast<unsigned>(hi) << 16) |
-                                               (static_cast<unsigned>(lo) & 0xffffu)));
-    };
-    const __m128i qw0 = pair(v.w00, v.w01), qw1 = pair(v.w10, v.w11);
+    const __m128i qw0 = weight_pair(v.w00, v.w01), qw1 = weight_pair(v.w10, v.w11);
     const __m128i qdelta = _mm_set1_epi32(1 << (kWBits - 5 - 1));
     __m128 qb0 = _mm_setzero_ps(), qb1 = _mm_setzero_ps();
     const auto ld = [&](const std::uint8_t* q) {
@@ -91,16 +110,9 @@ inline void sums_of_window(const std::uint8_t* jb, int bs, const std::int16_t* i
 #if defined(__SSE2__)
             const __m128i v00 = ld(j0 + x), v01 = ld(j0 + x + 1);
             const __m128i v10 = ld(j1 + x), v11 = ld(j1 + x + 1);
-            __m128i t0 = _mm_add_epi32(
-                _mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi16(v00, v01), qw0), qdelta),
-                _mm_madd_epi16(_mm_unpacklo_epi16(v10, v11), qw1));
-            __m128i t1 = _mm_add_epi32(
-                _mm_add_epi32(_mm_madd_epi16(_mm_unpackhi_epi16(v00, v01), qw0), qdelta),
-                _mm_madd_epi16(_mm_unpackhi_epi16(v10, v11), qw1));
-            t0 = _mm_srai_epi32(t0, kWBits - 5);
-            t1 = _mm_srai_epi32(t1, kWBits - 5);
-            const __m128i diff0 = _mm_sub_epi16(
-                _mm_packs_epi32(t0, t1), _mm_loadu_si128(reinterpret_cast<const __m128i*>(ir + x)));
+            const __m128i diff0 =
+                _mm_sub_epi16(bilinear8(v00, v01, v10, v11, qw0, qw1, qdelta, kWBits - 5),
+                              _mm_loadu_si128(reinterpret_cast<const __m128i*>(ir + x)));
             const __m128i diff2 = _mm_unpacklo_epi16(diff0, diff0);  // d0 d0 d1 d1 ...
             const __m128i diff1 = _mm_unpackhi_epi16(diff0, diff0);  // d4 d4 d5 d5 ...
             const __m128i d0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(dr + 2 * x));
@@ -153,11 +165,7 @@ inline void window_block(const std::uint8_t* s0, const std::uint8_t* s1, const s
                          const std::int16_t* g1, const Weights& w, std::int16_t* iv,
                          std::int16_t* dv, Lanes& lanes) {
     const __m128i z = _mm_setzero_si128();
-    const auto pair = [](int lo, int hi) {
-        return _mm_set1_epi32(static_cast<int>((static_cast<unsigned>(hi) << 16) |
-                                               (static_cast<unsigned>(lo) & 0xffffu)));
-    };
-    const __m128i qw0 = pair(w.w00, w.w01), qw1 = pair(w.w10, w.w11);
+    const __m128i qw0 = weight_pair(w.w00, w.w01), qw1 = weight_pair(w.w10, w.w11);
     const __m128i qdelta = _mm_set1_epi32(1 << (kWBits - 5 - 1));
     const __m128i qdelta_d = _mm_set1_epi32(1 << (kWBits - 1));
     const auto ld8 = [&](const std::uint8_t* q) {
@@ -167,26 +175,13 @@ inline void window_block(const std::uint8_t* s0, const std::uint8_t* s1, const s
         return _mm_loadu_si128(reinterpret_cast<const __m128i*>(q));
     };
     const __m128i v00 = ld8(s0), v01 = ld8(s0 + 1), v10 = ld8(s1), v11 = ld8(s1 + 1);
-    __m128i t0 = _mm_add_epi32(
-        _mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi16(v00, v01), qw0), qdelta),
-        _mm_madd_epi16(_mm_unpacklo_epi16(v10, v11), qw1));
-    __m128i t1 = _mm_add_epi32(
-        _mm_add_epi32(_mm_madd_epi16(_mm_unpackhi_epi16(v00, v01), qw0), qdelta),
-        _mm_madd_epi16(_mm_unpackhi_epi16(v10, v11), qw1));
-    t0 = _mm_srai_epi32(t0, kWBits - 5);
-    t1 = _mm_srai_epi32(t1, kWBits - 5);
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(iv), _mm_packs_epi32(t0, t1));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(iv),
+                     bilinear8(v00, v01, v10, v11, qw0, qw1, qdelta, kWBits - 5));
     for (int half = 0; half < 2; ++half) {
         const int o = 8 * half;  // int16 offset of pixels 4-7
         const __m128i d00 = ld16(g0 + o), d01 = ld16(g0 + o + 2);
         const __m128i d10 = ld16(g1 + o), d11 = ld16(g1 + o + 2);
-        __m128i u0 = _mm_add_epi32(
-            _mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi16(d00, d01), qw0), qdelta_d),
-            _mm_madd_epi16(_mm_unpacklo_epi16(d10, d11), qw1));
-        __m128i u1 = _mm_add_epi32(
-            _mm_add_epi32(_mm_madd_epi16(_mm_unpackhi_epi16(d00, d01), qw0), qdelta_d),
-            _mm_madd_epi16(_mm_unpackhi_epi16(d10, d11), qw1));
-        const __m128i g = _mm_packs_epi32(_mm_srai_epi32(u0, kWBits), _mm_srai_epi32(u1, kWBits));
+        const __m128i g = bilinear8(d00, d01, d10, d11, qw0, qw1, qdelta_d, kWBits);
         _mm_storeu_si128(reinterpret_cast<__m128i*>(dv + o), g);  // Ix0 Iy0 Ix1 Iy1 ...
         const __m128 fy = _mm_cvtepi32_ps(_mm_srai_epi32(g, 16));
         const __m128 fx = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(g, 16), 16));
