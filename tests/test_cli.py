@@ -689,12 +689,14 @@ def test_recover_refuses_options_it_would_ignore_or_cannot_use(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     src, out = _tracks(tmp_path / "t.txt"), tmp_path / "out.txt"
-    # was: --video (even a missing file) silently ignored without --link
-    assert main(["recover", str(src), "--out", str(out), "--video", str(tmp_path / "no.avi")]) == 2
+    # was: --video (even a missing file) silently ignored without --link; since stop 72 the
+    # fill reads it too (a hole handed to a neighbour), so it is checked with or without --link
+    missing = tmp_path / "no.avi"
+    assert main(["recover", str(src), "--out", str(out), "--video", str(missing)]) == 2
     assert capsys.readouterr().err.strip() == (
-        "pftrack recover: error: --video is used only by --link (its colour term); add --link "
-        "or drop it"
+        f"pftrack recover: error: video source not found: {missing}"
     )
+    assert not out.exists()
     for bad in ("nan", "-1", "0"):  # was: accepted (and ignored without --link)
         with pytest.raises(SystemExit) as exc:
             main(["recover", str(src), "--out", str(out), "--max-distance", bad])

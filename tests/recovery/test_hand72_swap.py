@@ -192,3 +192,10 @@ def test_recover_link_video_says_it_in_one_line(
     assert out.out.rstrip().endswith(said)  # --explain's last line
     assert main(["-q", "recover", str(src), "--out", str(tmp_path / "n.txt")]) == 0  # no video
     assert capsys.readouterr().err == ""
+    # --video without --link: the fill's check alone (was refused: "used only by --link")
+    alone = tmp_path / "alone.txt"
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        assert main(["recover", str(src), "--out", str(alone), "--video", str(video)]) == 0
+    assert capsys.readouterr().err == f"pftrack recover: warning: {src}: {said}\n"
+    assert np.array_equal(np.loadtxt(alone, delimiter=","), np.loadtxt(out_file, delimiter=","))

@@ -52,10 +52,11 @@ def add_parser(sub: Any) -> None:
                    "(default: 0; refused with another --method)")  # fmt: skip
     p.add_argument("--link", action="store_true", help="join fragments of one object first")
     add_max_distance(p)
-    p.add_argument("--video", help="video or image folder for the colour term of --link: "
-                   "only the frames of fragment ends are read, in one pass, then those of the "
-                   "holes' two sides (a hole whose sides each look more like another object "
-                   "than like each other is left unfilled, and said); refused when it "
+    p.add_argument("--video", help="video or image folder of the tracks: the colour term "
+                   "of --link (only the frames of fragment ends are read, in one pass) and, "
+                   "with or without --link, the holes' two sides (a hole whose sides each look "
+                   "more like another object than like each other is left unfilled, and said; "
+                   "another pass); refused when it "
                    "has fewer frames than the tracks, or boxes start more than a tenth of "
                    "its width or height past its right or bottom edge (default: none, motion "
                    "and size only)")  # fmt: skip
@@ -80,8 +81,6 @@ def run(args: argparse.Namespace) -> int:
     if batch.is_batch(args.tracks):
         return batch.run_recover(args)
     batch.refuse_batch_options(args)
-    if args.video and not args.link:
-        raise ValueError("--video is used only by --link (its colour term); add --link or drop it")
     args.tracks = args.tracks[0]
     from pftrack.cli._signals import hold_interrupts
     from pftrack.io.atomic import check_output, check_replaceable
