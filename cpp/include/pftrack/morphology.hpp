@@ -416,13 +416,13 @@ __attribute__((target("avx2"))) inline void zero_bytes_avx2(std::uint8_t* p, Ind
         std::memset(p + i, 0, static_cast<size_t>(n - i));
 }
 
-/// Whether the n bytes at p are all 0: 64 bytes a test (AVX2), the last n % 64 by overlapping
-/// loads (n >= 32) or byte by byte.
 /// The 32 bytes at p (unaligned).
 __attribute__((target("avx2"), always_inline)) inline __m256i load32_avx2(const std::uint8_t* p) {
     return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
 }
 
+/// Whether the n bytes at p are all 0: 64 bytes a test (AVX2), the last n % 64 by overlapping
+/// loads (n >= 32) or byte by byte.
 __attribute__((target("avx2"))) inline bool all_zero_avx2(const std::uint8_t* p, Index n) {
     Index i = 0;
     for (; i + 64 <= n; i += 64) {
@@ -498,9 +498,6 @@ PFTRACK_VECTOR_CLONES static void word_extremum_fill(bool dilate, const std::uin
         for (Index k = 0; k < n; ++k) o[k] = ((o[k] & a[k]) & valid[k]) | (fill & ~valid[k]);
 }
 
-/// n zero bytes at p: 32-byte stores where `avx2`, else memset. (glibc's memset takes `rep
-/// stosb` for a few kilobytes, which callgrind counts as one instruction a byte: the rows
-/// `clean_packed_blocks` leaves out would have counted as much as packing them.)
 /// Whether the n bytes at p are all 0 (`all_zero_avx2` where `avx2`).
 inline bool bytes_all_zero(const std::uint8_t* p, Index n, bool avx2) {
 #ifdef PFTRACK_MORPH_AVX2
@@ -512,6 +509,9 @@ inline bool bytes_all_zero(const std::uint8_t* p, Index n, bool avx2) {
     return x == n;
 }
 
+/// n zero bytes at p: 32-byte stores where `avx2`, else memset. (glibc's memset takes `rep
+/// stosb` for a few kilobytes, which callgrind counts as one instruction a byte: the rows
+/// `clean_packed_blocks` leaves out would have counted as much as packing them.)
 inline void zero_bytes(std::uint8_t* p, Index n, bool avx2) {
 #ifdef PFTRACK_MORPH_AVX2
     if (avx2) return zero_bytes_avx2(p, n);
