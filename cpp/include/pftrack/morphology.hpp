@@ -24,7 +24,6 @@
 #endif
 
 #include "check.hpp"
-#include "mask_scan.hpp"
 #include "types.hpp"
 
 namespace pftrack {
@@ -416,30 +415,6 @@ __attribute__((target("avx2"))) inline void zero_bytes_avx2(std::uint8_t* p, Ind
         std::memset(p + i, 0, static_cast<size_t>(n - i));
 }
 
-/// The 32 bytes at p (unaligned).
-__attribute__((target("avx2"), always_inline)) inline __m256i load32_avx2(const std::uint8_t* p) {
-    return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
-}
-
-/// Whether the n bytes at p are all 0: 64 bytes a test (AVX2), the last n % 64 by overlapping
-/// loads (n >= 32) or byte by byte.
-__attribute__((target("avx2"))) inline bool all_zero_avx2(const std::uint8_t* p, Index n) {
-    Index i = 0;
-    for (; i + 64 <= n; i += 64) {
-        const __m256i o = _mm256_or_si256(load32_avx2(p + i), load32_avx2(p + i + 32));
-        if (!_mm256_testz_si256(o, o)) return false;
-    }
-    if (i == n) return true;
-    if (n >= 32) {  // [i, n) lies within [j, j + 32) and [n - 32, n)
-        const Index j = i < n - 32 ? i : n - 32;
-        const __m256i o = _mm256_or_si256(load32_avx2(p + j), load32_avx2(p + n - 32));
-        return _mm256_testz_si256(o, o) != 0;
-    }
-    for (; i < n; ++i)
-        if (p[i] != 0) return false;
-    return true;
-}
-
 /// Each row's first cols / 32 * 32 bytes from the planes (AVX2): 255 where b is set (with
 /// `two`), ma where only a is, 0 elsewhere.
 __attribute__((target("avx2"))) inline void unpack_rows_avx2(const std::uint64_t* pa,
@@ -498,17 +473,6 @@ PFTRACK_VECTOR_CLONES static void word_extremum_fill(bool dilate, const std::uin
         for (Index k = 0; k < n; ++k) o[k] = ((o[k] & a[k]) & valid[k]) | (fill & ~valid[k]);
 }
 
-/// Whether the n bytes at p are all 0 (`all_zero_avx2` where `avx2`).
-inline bool bytes_all_zero(const std::uint8_t* p, Index n, bool avx2) {
-#ifdef PFTRACK_MORPH_AVX2
-    if (avx2) return all_zero_avx2(p, n);
-#endif
-    (void)avx2;
-    Index x = skip_zero_words(p, 0, n);
-    while (x < n && p[x] == 0) ++x;  // the word found, or the last n % 8
-    return x == n;
-}
-
 /// n zero bytes at p: 32-byte stores where `avx2`, else memset. (glibc's memset takes `rep
 /// stosb` for a few kilobytes, which callgrind counts as one instruction a byte: the rows
 /// `clean_packed_blocks` leaves out would have counted as much as packing them.)
@@ -544,6 +508,29 @@ struct PackedPass {
     MorphOp op;
 };
 
+/// Over the elements of `passes`: their widest horizontal extent `ext`, their largest vertical
+/// reach `reach`, and `summed`, each pass's reach added up (how far a foreground row can act,
+/// all passes together). False when an element lacks its anchor: its window may then hold no
+/// pixel of the image, where an erosion gives 255, a level the planes need not have (a 0/m
+/// mask).
+inline bool pass_reaches(const std::vector<PackedPass>& passes, Index& ext, Index& reach,
+                         Index& summed) {
+    ext = reach = summed = 0;
+    for (const PackedPass& p : passes) {
+        Index own = 0;
+        bool anchor = false;
+        for (const ElementRow& r : *p.element) {
+            ext = std::max({ext, -r.lo, r.hi});
+            own = std::max({own, -r.dy, r.dy});
+            anchor = anchor || (r.dy == 0 && r.lo <= 0 && r.hi >= 0);
+        }
+        if (!anchor) return false;
+        reach = std::max(reach, own);
+        summed += own;
+    }
+    return true;
+}
+
 /// dst (rows x cols, packed) = the passes applied in order to src (rows x cols, `src_stride`
 /// bytes a row), each as `morphology`, when src holds at most two non-zero values one of which,
 /// if two, is 255 (0 and 255; 0 and m; 0, m and 255): the same bytes as the byte path. Returns
@@ -560,18 +547,8 @@ inline bool clean_packed(const std::uint8_t* src, Index src_stride, std::uint8_t
     return false;  // the word layout assumes little-endian loads
 #else
     using u64 = std::uint64_t;
-    Index ext = 0, reach = 0;
-    for (const PackedPass& p : passes) {
-        bool anchor = false;
-        for (const ElementRow& r : *p.element) {
-            ext = std::max({ext, -r.lo, r.hi});
-            reach = std::max({reach, -r.dy, r.dy});
-            anchor = anchor || (r.dy == 0 && r.lo <= 0 && r.hi >= 0);
-        }
-        // without its anchor an element's window may hold no pixel of the image: an erosion
-        // gives 255 there, a level the planes need not have (a 0/m mask)
-        if (!anchor) return false;
-    }
+    Index ext, reach, summed;
+    if (!pass_reaches(passes, ext, reach, summed)) return false;
     const Index data_words = (cols + 63) / 64;
     const Index S = (cols + ext + 63) / 64;  // a row: cols bits and >= ext bits of padding
     const Index G = ext / 64 + 2;             // guard words: a shifted read's reach, and a byte
@@ -818,17 +795,8 @@ inline bool clean_packed(const std::uint8_t* src, Index src_stride, std::uint8_t
 inline bool clean_packed_blocks(const std::uint8_t* src, Index src_stride, std::uint8_t* dst,
                                 Index rows, Index cols, const std::vector<PackedPass>& passes,
                                 bool simd, PackedScratch& s) {
-    Index margin = 0;
-    for (const PackedPass& p : passes) {
-        Index reach = 0;
-        bool anchor = false;
-        for (const ElementRow& r : *p.element) {
-            reach = std::max({reach, -r.dy, r.dy});
-            anchor = anchor || (r.dy == 0 && r.lo <= 0 && r.hi >= 0);
-        }
-        if (!anchor) return false;  // the argument above needs it (and clean_packed too)
-        margin += reach;
-    }
+    Index ext, reach, margin;  // margin: the passes' summed reach
+    if (!pass_reaches(passes, ext, reach, margin)) return false;  // the argument above needs it
 #ifdef PFTRACK_MORPH_AVX2
     const bool avx2 = simd && __builtin_cpu_supports("avx2");
 #else
@@ -836,7 +804,7 @@ inline bool clean_packed_blocks(const std::uint8_t* src, Index src_stride, std::
 #endif
     s.groups.clear();
     for (Index y = 0; y < rows; ++y) {
-        if (detail::bytes_all_zero(src + y * src_stride, cols, avx2)) continue;
+        if (detail::all_zero(src + y * src_stride, cols)) continue;  // the byte path's test
         if (!s.groups.empty() && y - s.groups.back().second - 1 <= 2 * margin)
             s.groups.back().second = y;
         else
