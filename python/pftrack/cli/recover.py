@@ -53,10 +53,10 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--link", action="store_true", help="join fragments of one object first")
     add_max_distance(p)
     p.add_argument("--video", help="video or image folder of the tracks: the colour term "
-                   "of --link (only the frames of fragment ends are read, in one pass) and, "
+                   "of --link (only the frames of fragment ends are read) and, "
                    "with or without --link, the holes' two sides (a hole whose sides each look "
-                   "more like another object than like each other is left unfilled, and said; "
-                   "another pass); refused when it "
+                   "more like another object than like each other is left unfilled, and said): "
+                   "both in one pass over the video; refused when it "
                    "has fewer frames than the tracks, or boxes start more than a tenth of "
                    "its width or height past its right or bottom edge (default: none, motion "
                    "and size only)")  # fmt: skip
@@ -86,8 +86,14 @@ def run(args: argparse.Namespace) -> int:
     from pftrack.io.atomic import check_output, check_replaceable
     from pftrack.io.mot import is_mot_text, say_far_boxes, write_mot
     from pftrack.recovery import fill_gaps, link_tracklets
-    from pftrack.recovery.fill import copied_values, jump_note, swap_note, unfilled_note
-    from pftrack.recovery.linking import link_config_for, read_tracks
+    from pftrack.recovery.fill import (
+        copied_values,
+        jump_note,
+        side_frames,
+        swap_note,
+        unfilled_note,
+    )
+    from pftrack.recovery.linking import BoxColours, link_config_for, link_frames, read_tracks
 
     src = Path(args.tracks)
     out = Path(args.out)
@@ -117,13 +123,17 @@ def run(args: argparse.Namespace) -> int:
         frames = FrameSequence(args.video)  # read when the colour term asks, in one pass
         check_video(args.video, frames, rows, src)
     try:
+        colours: Any = frames
         if args.link:
             cfg = link_config_for(rows, args.max_gap, args.max_distance)
-            rows, mapping = link_tracklets(rows, cfg, frames)
+            if frames is not None:  # the linker's and the holes' frames in one decode
+                wanted = link_frames(rows, cfg) | side_frames(rows, args.max_gap)
+                colours = BoxColours(frames, rows, wanted)
+            rows, mapping = link_tracklets(rows, cfg, colours)
             n_links = len(mapping)
         t0 = time.perf_counter()
-        # with the video, the holes' sides too (a second pass): two neighbours under one id
-        filled, rep = fill_gaps(rows, args.method, args.max_gap, seed=args.seed, frames=frames)
+        # with the video, the holes' sides too: two neighbours under one id
+        filled, rep = fill_gaps(rows, args.method, args.max_gap, seed=args.seed, frames=colours)
         dt = time.perf_counter() - t0
     finally:
         if frames is not None:

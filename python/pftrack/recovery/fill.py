@@ -59,6 +59,7 @@ __all__ = [
     "jump_note",
     "long_holes",
     "short_holes",
+    "side_frames",
     "swap_holes",
     "swap_note",
     "unfilled_note",
@@ -414,6 +415,26 @@ def swap_holes(r: F64, holes: NDArray[np.int64], frames: Sequence[NDArray[np.uin
         )
         out[k] = d / best
     return out
+
+
+def side_frames(rows: ArrayLike, max_gap: int) -> set[int]:
+    """The 0-based frames of the two sides of every hole of at most `max_gap` missing frames.
+
+    A superset of the frames :func:`swap_holes` reads for `rows` (it judges only the holes
+    the jump rule lets through): with :func:`pftrack.recovery.linking.link_frames`, what a
+    :class:`~pftrack.recovery.linking.BoxColours` must hold for ``recover --link --video``
+    to decode its video once. The holes a join of the linker makes have the joined
+    fragments' ends as sides, which ``link_frames`` holds.
+    """
+    a = check_rows(rows, "side_frames")
+    if not len(a):
+        return set()
+    r = a[np.lexsort((a[:, 0], a[:, 1]))]
+    step = np.diff(r[:, 0])
+    hole = np.flatnonzero((r[1:, 1] == r[:-1, 1]) & (step > 1) & (step <= max_gap + 1))
+    return set((r[hole, 0].astype(np.int64) - 1).tolist()) | set(
+        (r[hole + 1, 0].astype(np.int64) - 1).tolist()
+    )
 
 
 def swap_note(count: int, largest: float) -> str:

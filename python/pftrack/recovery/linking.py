@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
+from typing import Any, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -46,6 +47,7 @@ __all__ = [
     "FILLED_MARK",
     "FLAG_COLUMN",
     "MAX_ID",
+    "BoxColours",
     "LinkConfig",
     "box_centres",
     "check_boxes",
@@ -56,6 +58,7 @@ __all__ = [
     "frame_histograms",
     "gate_for_rows",
     "link_cost_matrix",
+    "link_frames",
     "link_costs",
     "link_tracklets",
     "pixel_scale",
@@ -276,6 +279,8 @@ def frame_histograms(
     in one pass, holding one frame. The linker's colour term (:func:`link_costs`) and the
     fill's swap rule (:func:`pftrack.recovery.fill.swap_holes`) read frames through it.
     """
+    if isinstance(frames, BoxColours):  # read already, in the pass that served every reader
+        return frames.histograms(boxes)
     out: dict[int, F64 | None] = {}
     n = len(frames)
     for f in sorted(boxes):
@@ -285,6 +290,101 @@ def frame_histograms(
         b = boxes[f]
         out[f] = box_histograms(hsv_bins(frames[f]), _to_cxcywh(b)) if len(b) else np.zeros((0, 0))
     return out
+
+
+class BoxColours(Sequence[NDArray[np.uint8]]):
+    """The colour histograms of every box of `rows` at chosen frames, read in one pass.
+
+    Stands for `frames` where several readers need colour at frames known beforehand:
+    ``pftrack recover --link --video`` gives it to :func:`link_tracklets` (the fragment ends'
+    frames, :func:`link_frames`) and then to :func:`pftrack.recovery.fill.fill_gaps` (the
+    holes' sides, :func:`pftrack.recovery.fill.side_frames`), so the video is decoded once,
+    not once per reader. :func:`frame_histograms` answers from it: each box's histogram is
+    the one a reader binning that frame would compute (the same call on the same frame), so
+    the readers' results are those of reading `frames` themselves.
+
+    Parameters
+    ----------
+    frames : sequence of (H, W, 3) uint8
+        The video's BGR frames (index ``frame - 1``), e.g. a
+        :class:`pftrack.io.video.FrameSequence`; read here, in increasing order, each once.
+    rows : (M, >=6) ndarray
+        Rows ``frame, id, left, top, width, height, ...``; only their boxes are used (ids may
+        change afterwards, as linking changes them).
+    wanted : iterable of int
+        0-based frames to read; each box of `rows` at these frames is binned.
+    """
+
+    def __init__(self, frames: Sequence[NDArray[np.uint8]], rows: F64, wanted: Iterable[int]):
+        self.frames = frames
+        fr = rows[:, 0].astype(np.int64) - 1
+        want = np.unique(np.fromiter(wanted, dtype=np.int64))
+        at = np.flatnonzero(np.isin(fr, want))
+        at = at[np.argsort(fr[at], kind="stable")]
+        cuts = np.flatnonzero(np.diff(fr[at])) + 1
+        boxes = {
+            int(fr[g[0]]): np.unique(rows[g, 2:6], axis=0) for g in np.split(at, cuts) if len(g)
+        }
+        self._boxes = boxes
+        self._hists = frame_histograms(boxes, frames)
+        # each frame's boxes by value: a reader asks for a box by its four numbers
+        self._index = {f: {b.tobytes(): k for k, b in enumerate(v)} for f, v in boxes.items()}
+
+    def __len__(self) -> int:
+        return len(self.frames)
+
+    @overload
+    def __getitem__(self, k: int) -> NDArray[np.uint8]: ...
+    @overload
+    def __getitem__(self, k: slice) -> Sequence[NDArray[np.uint8]]: ...
+    def __getitem__(self, k: int | slice) -> Any:
+        """The underlying frame (a reader that bins its own frames reads them again)."""
+        return self.frames[k]
+
+    def histograms(self, boxes: dict[int, F64]) -> dict[int, F64 | None]:
+        """What :func:`frame_histograms` returns for `boxes` on the frames; read already.
+
+        A frame or box that was not read beforehand is read now (another pass: a caller's
+        `wanted` missed it), so the answer never depends on what was read.
+        """
+        out: dict[int, F64 | None] = {}
+        missing: dict[int, F64] = {}
+        for f, b in boxes.items():
+            h, index = self._hists.get(f), self._index.get(f)
+            if not len(b):
+                out[f] = None if not 0 <= f < len(self) else np.zeros((0, 0))
+                continue
+            if f not in self._hists or index is None:
+                missing[f] = b
+                continue
+            if h is None:
+                out[f] = None
+                continue
+            rows = [index.get(np.ascontiguousarray(x, dtype=np.float64).tobytes()) for x in b]
+            if any(k is None for k in rows):
+                missing[f] = b
+                continue
+            out[f] = h[np.array(rows, dtype=np.intp)]
+        if missing:
+            out.update(frame_histograms(missing, self.frames))
+        return out
+
+
+def link_frames(rows: ArrayLike, config: LinkConfig) -> set[int]:
+    """The 0-based frames whose colour :func:`link_tracklets` reads for `rows` and `config`.
+
+    The frames of the fragment ends of the pairs within the gates (:func:`link_costs`), none
+    when ``config.w_appearance`` is 0: what a :class:`BoxColours` must hold to serve the
+    linker without reading the video again.
+    """
+    a = check_rows(rows, "link_frames", "tracks")
+    if not len(a) or config.w_appearance <= 0:
+        return set()
+    tracks = split_tracks(a)
+    ids, i, j, _ = link_costs(tracks, config)
+    ends = [int(tracks[ids[k]][-1, 0]) - 1 for k in np.unique(i).tolist()]
+    starts = [int(tracks[ids[k]][0, 0]) - 1 for k in np.unique(j).tolist()]
+    return set(ends) | set(starts)
 
 
 def _end_histograms(
