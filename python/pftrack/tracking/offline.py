@@ -16,7 +16,7 @@ the smoothed boxes match the annotation far more often than the detections thems
 from __future__ import annotations
 
 import heapq
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Literal
 
@@ -31,9 +31,10 @@ from pftrack._typing import F64, IntLike, RecoveryMethod
 from pftrack.boxes import _intersection, _iou_rows, _to_cxcywh, _to_xywh
 from pftrack.detection.size_model import expected_size, head_height, theil_sen
 from pftrack.kalman import Cov, Mean, _cv_predict, _cv_update_where, rts_smooth
-from pftrack.recovery.fill import DEFAULT_MAX_GAP, MAX_GAP_LIMIT, fill_rows
+from pftrack.recovery.fill import DEFAULT_MAX_GAP, MAX_GAP_LIMIT, fill_rows, side_frames
 from pftrack.recovery.linking import (
     MAX_ID,
+    BoxColours,
     LinkConfig,
     _pair_blocks,
     check_boxes,
@@ -41,6 +42,7 @@ from pftrack.recovery.linking import (
     check_tracked,
     check_unique,
     link_config_for,
+    link_frames,
     link_tracklets,
 )
 from pftrack.recovery.names import DEFAULT_METHOD, METHODS
@@ -654,6 +656,7 @@ def smooth_tracks(
     crossings: CrossingConfig | None = None,
     relink_coast: int | None = None,
     max_gap: IntLike | None = None,
+    frames: Sequence[NDArray[np.uint8]] | None = None,
 ) -> F64:
     """Offline pass over any tracker's MOTChallenge rows: link fragments, fill holes, smooth.
 
@@ -708,6 +711,13 @@ def smooth_tracks(
         it without `link`). None (default): ``link.max_gap``, and no filling without `link`.
         A hole longer than the filling's gap is not bridged by the smoother either: the
         track is smoothed in pieces split there (``BoxSmoother.max_hole`` at most that gap).
+    frames : sequence of (H, W, 3) uint8, optional
+        The video's BGR frames (index ``frame - 1``), in the rows' pixels: the linker's colour
+        term (:func:`~pftrack.recovery.linking.link_tracklets`) and the fill's swap rule (a
+        hole whose sides each look more like another object is left unfilled,
+        :func:`pftrack.recovery.fill.swap_holes`), on the boxes the smoother fits. None
+        (default): motion and size only, as the tracker's own pass (docs/recovery.md,
+        "Colour in the offline pass").
 
     Returns
     -------
@@ -782,15 +792,24 @@ def smooth_tracks(
     fill_gap = max_gap if max_gap is not None else None if link is None else link.max_gap
     if link is not None and relink_coast is not None:
         a, obs, z = split_refound(a, obs, z, relink_coast)
+    if frames is not None and not isinstance(frames, BoxColours):
+        # the linker's frames and the holes' sides in one decode, the boxes linked (the rows')
+        # and filled (the measured ones) both binned
+        wanted = set() if link is None else link_frames(a, link)
+        if fill_gap is not None:
+            wanted |= side_frames(a, fill_gap)
+        measured = a.copy()
+        measured[:, 2:6] = z
+        frames = BoxColours(frames, np.vstack([a, measured]), wanted)
     if link is not None:
-        a, _ = link_tracklets(a, link)
+        a, _ = link_tracklets(a, link, frames)
     if crossings is not None and crossings.enabled:
         a = repair_crossings(a, obs, crossings, z)
     order = np.lexsort((a[:, 0], a[:, 1]))  # by id, then frame
     a, obs, z = a[order], obs[order], z[order]
     new = np.zeros(len(a), dtype=bool)
     if smoother is not None and fill_gap is not None:
-        a, obs, z, new = _add_hole_rows(a, obs, z, fill_gap, fill_method, seed)
+        a, obs, z, new = _add_hole_rows(a, obs, z, fill_gap, fill_method, seed, frames)
         # a hole left unfilled is no bridge for the smoother either: its two sides are
         # smoothed apart (was: joined through holes of up to max_hole = 300 frames, so an id a
         # tracker gave a second, still person 41 frames later bent both people's boxes by 10 px)
@@ -1257,7 +1276,13 @@ def split_refound(
 
 
 def _add_hole_rows(
-    a: F64, obs: NDArray[np.bool_], z: F64, max_gap: int, method: RecoveryMethod, seed: int
+    a: F64,
+    obs: NDArray[np.bool_],
+    z: F64,
+    max_gap: int,
+    method: RecoveryMethod,
+    seed: int,
+    frames: Sequence[NDArray[np.uint8]] | None = None,
 ) -> tuple[F64, NDArray[np.bool_], F64, NDArray[np.bool_]]:
     """Add a flagged row for every frame missing inside a track, recovered by `method`.
 
@@ -1270,7 +1295,7 @@ def _add_hole_rows(
     if not same:  # was: always a copy of the rows (50 MB of 630 000 rows at the peak)
         src = a.copy()
         src[:, 2:6] = z
-    extra, _ = fill_rows(src, method, max_gap, seed=seed)
+    extra, _ = fill_rows(src, method, max_gap, seed=seed, frames=frames)
     n = len(a)
     if not len(extra):
         return a, obs, z, np.zeros(n, dtype=bool)
