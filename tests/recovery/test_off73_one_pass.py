@@ -137,6 +137,10 @@ def test_no_colour_reads_nothing() -> None:
     assert side_frames(one, 30) == {0, 3}  # the 35-frame hole is longer than max_gap
     with pytest.raises(ValueError, match="side_frames"):
         side_frames(np.zeros((2, 3)), 30)
+    with pytest.raises(ValueError, match="link_frames.*duplicate"):
+        link_frames(np.array([one[0], one[0]]), LinkConfig())
+    with pytest.raises(ValueError, match="link_frames.*id -1"):
+        link_frames(np.array([[1, -1, 0, 0, 5, 5]], float), LinkConfig())
 
 
 def test_recover_link_video_reads_in_one_pass(

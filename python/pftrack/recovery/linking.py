@@ -378,6 +378,8 @@ def link_frames(rows: ArrayLike, config: LinkConfig) -> set[int]:
     linker without reading the video again.
     """
     a = check_rows(rows, "link_frames", "tracks")
+    check_unique(a, who="link_frames")  # as link_tracklets refuses them
+    check_tracked(a, who="link_frames")
     if not len(a) or config.w_appearance <= 0:
         return set()
     tracks = split_tracks(a)
