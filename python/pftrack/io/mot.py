@@ -230,6 +230,18 @@ def read_mot(
         refuse_dash(p, what)
         refuse_loop(p, what)
         raise FileNotFoundError(f"{what} not found: {p}")
+    try:
+        return _read_rows(p, what, warn_extra)
+    except OSError as exc:
+        if exc.filename is not None:  # open()'s errors name the file already
+            raise
+        # a read that fails part-way (a failing disk, a network file system, /proc/self/mem)
+        # raised "[Errno 5] Input/output error", naming no file: now "Input/output error: PATH"
+        raise OSError(exc.errno, exc.strerror or str(exc), str(p)) from None
+
+
+def _read_rows(p: Path, what: str, warn_extra: bool) -> NDArray[np.float64]:
+    """:func:`read_mot` of the regular file `p`, once its path is checked."""
     _refuse_binary(p, what)
     fast = _read_fast(p)
     if fast is not None:
@@ -270,7 +282,7 @@ def read_mot(
         warn(
             f"{what} {p} has lines of {most} columns: columns past 10 are not kept",
             UserWarning,
-            stacklevel=2,
+            stacklevel=3,  # read_mot's caller
         )
     return a
 
