@@ -135,3 +135,23 @@ def test_batch_says_it_as_the_sequences_warning(
     said = [line for line in run.stderr.splitlines() if SAID in line]
     assert len(said) == 1 and said[0].startswith("seq0: warning: "), run.stderr
     assert SAID in (tmp_path / "out" / "seq0.json").read_text()
+
+
+def test_render_says_it_of_tracks_numbered_from_0(
+    scene: tuple[Path, np.ndarray], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    video, dets = scene
+    tracks = make_scene(n_frames=FRAMES, rng=1).truth  # ids, frames 1-40
+    for name, rows, said in (("t1.txt", tracks, 0), ("t0.txt", tracks[tracks[:, 0] < FRAMES], 1)):
+        path = det_file(tmp_path / name, rows)
+        argv = ["-q", "render", str(video), str(path), "--out", str(tmp_path / f"{name}.mp4")]
+        assert main(argv) == 0
+        notes = [line for line in capsys.readouterr().err.splitlines() if SAID in line]
+        assert len(notes) == said, notes
+    assert notes[0].startswith(
+        f"pftrack render: warning: {path}: rows on 39 of frames 1-39, and none on the video's "
+        "last frame, 40: "
+    )
+    assert notes[0].endswith(
+        f"'{{$1+=1}}1' {path} > tracks1.txt); if the file counts from 1, nothing is wrong"
+    )

@@ -875,7 +875,14 @@ DENSE_SHARE = 0.9
 DENSE_FRAMES = 10
 
 
-def zero_based_note(frames: Iterable[int], n_frames: int, path: object) -> str | None:
+def zero_based_note(
+    frames: Iterable[int],
+    n_frames: int,
+    path: object,
+    *,
+    what: str = "detections",
+    mended: str = "det1.txt",
+) -> str | None:
     """What to say of detections that may count frames from 0 without a row on frame 0, or None.
 
     A file numbered from 0 (KITTI's labels, a decoder's index, Python's ``enumerate``) whose
@@ -896,6 +903,11 @@ def zero_based_note(frames: Iterable[int], n_frames: int, path: object) -> str |
         The video's frames, 0 when unknown.
     path : object
         How the note names the file.
+    what : str
+        What its rows are (``"detections"``; ``"rows"`` for the tracks ``pftrack render``
+        draws: a box on the frame before its own alike).
+    mended : str
+        The name the mend's command writes.
     """
     held = np.unique(np.fromiter(frames, dtype=np.int64))
     if n_frames < 2 or len(held) < DENSE_FRAMES or held[-1] != n_frames - 1:
@@ -904,9 +916,9 @@ def zero_based_note(frames: Iterable[int], n_frames: int, path: object) -> str |
     if len(held) < DENSE_SHARE * (last - first + 1):
         return None
     return (
-        f"{path}: detections on {len(held)} of frames {first}-{last}, and none on the video's "
+        f"{path}: {what} on {len(held)} of frames {first}-{last}, and none on the video's "
         f"last frame, {n_frames}: numbered from 0 (KITTI, a decoder's index, enumerate)? "
         "pftrack reads MOTChallenge frames, which count from 1, and would draw every box on "
         f"the frame before its own; if so, add 1 to every frame (awk -F, -v OFS=, "
-        f"'{{$1+=1}}1' {path} > det1.txt); if the file counts from 1, nothing is wrong"
+        f"'{{$1+=1}}1' {path} > {mended}); if the file counts from 1, nothing is wrong"
     )
