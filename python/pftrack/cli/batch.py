@@ -91,12 +91,25 @@ BATCH_ONLY = ("scheduler", "workers")
 def refuse_batch_options(args: argparse.Namespace) -> None:
     """Refuse the batch options on a command given one file (they would do nothing).
 
+    A one-file command's first check, so a missing input is said first: ``pftrack recover
+    results/ --out filled/ --workers 0`` with no ``results/`` (a batch that never ran) said
+    ``--workers applies to a batch ...: drop it``, then ``--out filled/ names a folder``, two
+    mends for a folder that is not there.
+
     Raises
     ------
+    FileNotFoundError
+        The one input (``args.tracks``) does not exist (a broken link is named when read).
     ValueError
         ``--scheduler`` or ``--workers`` was given (``$DASK_SCHEDULER_ADDRESS``
         is not: it is read only by a batch).
     """
+    for path in getattr(args, "tracks", None) or []:
+        if not os.path.lexists(path):
+            from pftrack.io.atomic import refuse_dash
+
+            refuse_dash(Path(path), "tracks file")  # "-": stdin is not read, said so
+            raise FileNotFoundError(f"tracks file not found: {path}")
     given = [
         f"--{n}"
         for n in BATCH_ONLY

@@ -92,6 +92,7 @@ def run(args: argparse.Namespace) -> int:
         staged_outputs,
     )
     from pftrack.io.marks import is_marked_image
+    from pftrack.io.mot import zero_based_note
     from pftrack.io.video import (
         FrameSource,
         check_outside_frames,
@@ -172,6 +173,11 @@ def run(args: argparse.Namespace) -> int:
             f"{'are' if len(late) != 1 else 'is'} past the video's last frame {drawn[0]}: not "
             f"drawn{gap}"
         )
+    elif len(rows):  # was said nowhere: rows numbered from 0 drawn a frame early
+        base = zero_based_note(
+            rows[:, 0].astype(np.int64), drawn[0], args.tracks, what="rows", mended="tracks1.txt"
+        )
+        notes += [base] if base is not None else []
     for note in notes:
         print(f"pftrack render: warning: {_shown(note)}", file=sys.stderr)
     shown = rows[rows[:, 0] <= drawn[0]]

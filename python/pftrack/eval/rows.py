@@ -37,6 +37,7 @@ __all__ = [
     "say_none_matched",
     "check_eval_rows",
     "check_unique_ids",
+    "frame_ranges_notes",
     "guess_benchmark",
     "mot_iou",
     "prepare_mot",
@@ -413,6 +414,48 @@ def _span(frames: NDArray[np.float64]) -> str:
     """``frame F`` or ``frames F-L`` of a column of frame numbers."""
     first, last = int(frames.min()), int(frames.max())
     return f"frame {first}" if first == last else f"frames {first}-{last}"
+
+
+#: The fewest frames with boxes of one file outside the other's frames that
+#: :func:`frame_ranges_notes` says: a tracker's few boxes after the last person left, or a
+#: truth that starts when the first one comes in, are scored as they are without a word.
+APART_FRAMES = 10
+
+
+def frame_ranges_notes(
+    gt: NDArray[np.float64], result: NDArray[np.float64], *, gt_name: str, res_name: str
+) -> list[str]:
+    """What to say of a result and a ground truth that cover different frames: 0 to 2 notes.
+
+    Boxes of the result on frames before the truth's first or after its last are all false
+    positives, and truth boxes outside the result's frames all misses: right when nobody was
+    there or the tracker stopped early, wrong when one file covers part of the video (a truth
+    annotated over frames 1-40 of 71 scored 133 false positives, MOTA 21.4 against 81.4 on the
+    frames both cover, without a word). Said, with the count and the frames, when one file has
+    boxes on :data:`APART_FRAMES` frames or more outside the other's first..last frame. Empty
+    files say nothing here (their own notes do).
+    """
+    if not len(gt) or not len(result):
+        return []
+    notes: list[str] = []
+    pairs = (
+        (result, gt, res_name, gt_name, "false positives", "cover only part of the video"),
+        (gt, result, gt_name, res_name, "misses", "track only part of the video"),
+    )
+    for rows, other, name, other_name, scored, why in pairs:
+        first, last = int(other[:, FRAME].min()), int(other[:, FRAME].max())
+        outside = (rows[:, FRAME] < first) | (rows[:, FRAME] > last)
+        frames = np.unique(rows[outside, FRAME])
+        if len(frames) < APART_FRAMES:
+            continue
+        n, share = int(outside.sum()), 100.0 * outside.mean()
+        cut = f"awk -F, '$1>={first} && $1<={last}' {name} > cut.txt"
+        notes.append(
+            f"{name}: {n} of its {len(rows)} boxes ({share:.0f} %) lie on {len(frames)} frames "
+            f"outside {other_name}'s {_span(other[:, FRAME])} ({_span(frames)}), all scored "
+            f"as {scored}: does {other_name} {why}? If so, score the frames both cover ({cut})"
+        )
+    return notes
 
 
 def none_matched(

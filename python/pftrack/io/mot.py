@@ -230,6 +230,18 @@ def read_mot(
         refuse_dash(p, what)
         refuse_loop(p, what)
         raise FileNotFoundError(f"{what} not found: {p}")
+    try:
+        return _read_rows(p, what, warn_extra)
+    except OSError as exc:
+        if exc.filename is not None:  # open()'s errors name the file already
+            raise
+        # a read that fails part-way (a failing disk, a network file system, /proc/self/mem)
+        # raised "[Errno 5] Input/output error", naming no file: now "Input/output error: PATH"
+        raise OSError(exc.errno, exc.strerror or str(exc), str(p)) from None
+
+
+def _read_rows(p: Path, what: str, warn_extra: bool) -> NDArray[np.float64]:
+    """:func:`read_mot` of the regular file `p`, once its path is checked."""
     _refuse_binary(p, what)
     fast = _read_fast(p)
     if fast is not None:
@@ -270,7 +282,7 @@ def read_mot(
         warn(
             f"{what} {p} has lines of {most} columns: columns past 10 are not kept",
             UserWarning,
-            stacklevel=2,
+            stacklevel=3,  # read_mot's caller
         )
     return a
 
@@ -852,3 +864,61 @@ def group_by_frame(rows: NDArray[np.float64]) -> dict[int, NDArray[np.float64]]:
     frames, starts = np.unique(r[:, FRAME].astype(np.int64), return_index=True)
     ends = list(starts[1:]) + [len(r)]
     return {int(f): r[s:e] for f, s, e in zip(frames, starts, ends, strict=True)}
+
+
+#: The share of the frames between a detection file's first and last frame that must hold a row
+#: for its ending one frame short of the video to be said (:func:`zero_based_note`): every
+#: det.txt here has rows on every frame of its range (PETS09, TUD-Campus, ADL-Rundle-6,
+#: ETH-Sunnyday, KITTI-17); a detector that finds nothing on many frames may end anywhere.
+DENSE_SHARE = 0.9
+#: The fewest frames with rows that :func:`zero_based_note` judges.
+DENSE_FRAMES = 10
+
+
+def zero_based_note(
+    frames: Iterable[int],
+    n_frames: int,
+    path: object,
+    *,
+    what: str = "detections",
+    mended: str = "det1.txt",
+) -> str | None:
+    """What to say of detections that may count frames from 0 without a row on frame 0, or None.
+
+    A file numbered from 0 (KITTI's labels, a decoder's index, Python's ``enumerate``) whose
+    first detection is on frame 3, say, passes every check: read as MOTChallenge's frames from
+    1, every box lands one frame late, on a video one frame longer than the file's last frame.
+    With a row on frame 0 it is refused (:func:`read_mot`). Said when the file's last frame is
+    the video's last but one (`n_frames` - 1) while it holds rows on nearly every frame of its
+    range (:data:`DENSE_SHARE`, at least :data:`DENSE_FRAMES` frames): a detector that finds
+    something on almost every frame and nothing on the last is rare; the same file numbered
+    from 1 would reach the video's last frame. Nothing is said when the count is unknown
+    (`n_frames` 0: a camera, a stream) or the file reaches the last frame.
+
+    Parameters
+    ----------
+    frames : iterable of int
+        The frames (as numbered in the file) that hold at least one detection.
+    n_frames : int
+        The video's frames, 0 when unknown.
+    path : object
+        How the note names the file.
+    what : str
+        What its rows are (``"detections"``; ``"rows"`` for the tracks ``pftrack render``
+        draws: a box on the frame before its own alike).
+    mended : str
+        The name the mend's command writes.
+    """
+    held = np.unique(np.fromiter(frames, dtype=np.int64))
+    if n_frames < 2 or len(held) < DENSE_FRAMES or held[-1] != n_frames - 1:
+        return None
+    first, last = int(held[0]), int(held[-1])
+    if len(held) < DENSE_SHARE * (last - first + 1):
+        return None
+    return (
+        f"{path}: {what} on {len(held)} of frames {first}-{last}, and none on the video's "
+        f"last frame, {n_frames}: numbered from 0 (KITTI, a decoder's index, enumerate)? "
+        "pftrack reads MOTChallenge frames, which count from 1, and would draw every box on "
+        f"the frame before its own; if so, add 1 to every frame (awk -F, -v OFS=, "
+        f"'{{$1+=1}}1' {path} > {mended}); if the file counts from 1, nothing is wrong"
+    )

@@ -1239,9 +1239,17 @@ def _frame_order(
     if sequence is not None and numbers[0] != 1:
         if numbers[0] > 1:
             raise missing(1, len(first), f"{names}; frame 1 of a MOTChallenge sequence is image 1")
+        # numbered from 0 (a dump by a decoder's index): was said without a way out
+        mend = (
+            f": numbered from 0? rename each image to its number plus 1 ({ordered[0].name} to "
+            f"{str(1).zfill(len(first))}{ordered[0].suffix}, ...) and add 1 to the frames of "
+            "its det.txt and gt.txt, which number the frames by the names"
+            if numbers[0] == 0
+            else ""
+        )
         raise ValueError(
             f"{folder}: image {first} is not a frame ({names}; a MOTChallenge sequence's "
-            "frames start at 1)"
+            f"frames start at 1{mend})"
         )
     for k in range(1, len(numbers)):
         if numbers[k] == numbers[k - 1]:
