@@ -137,6 +137,21 @@ def test_batch_says_it_as_the_sequences_warning(
     assert SAID in (tmp_path / "out" / "seq0.json").read_text()
 
 
+def test_track_path_says_it_once_as_the_command_does(
+    scene: tuple[Path, np.ndarray], tmp_path: Path
+) -> None:
+    from pftrack.tracking.run import track_path
+
+    video, dets = scene
+    zero = dets.copy()
+    zero[:, 0] -= 1
+    cut = det_file(tmp_path / "det0.txt", zero[zero[:, 0] >= 3])
+    with pytest.warns(UserWarning) as said:
+        track_path(video, detections=cut, show_progress=False)
+    notes = [str(w.message) for w in said if SAID in str(w.message)]
+    assert len(notes) == 1 and notes[0].startswith(f"{cut}: detections on 37 of frames 3-39")
+
+
 def test_render_says_it_of_tracks_numbered_from_0(
     scene: tuple[Path, np.ndarray], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -362,7 +362,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         :func:`~pftrack.io.mot.write_mot`), the annotated video if asked for, and the figures;
         its `error` is set if the ground truth could not be scored (the rows are still there).
     """
-    from pftrack.io.mot import as_written, read_ground_truth, read_mot, zero_based_note
+    from pftrack.io.mot import as_written, read_ground_truth
     from pftrack.io.video import FrameSource, info_scale, read_seqinfo
     from pftrack.recovery.linking import check_scored_ids
     from pftrack.tracking.run import SeqinfoScale, track_path
@@ -401,13 +401,6 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         gap = gap_note(frames)
         if gap is not None:
             warn(gap)  # the sequence's warning, as pftrack track says it
-    if det is not None:  # as pftrack track says it (a file it cannot read: refused below)
-        with contextlib.suppress(OSError, ValueError):
-            rows = read_mot(det, what="detection file")
-            held = rows[(rows[:, 4] > 0) & (rows[:, 5] > 0), 0].astype(np.int64)
-            base = zero_based_note(held, frames.counted_frames, det)
-            if base is not None:
-                warn(base)
     run = track_path(
         frames,
         detections=det,

@@ -878,7 +878,17 @@ def track_path(
     """
     smooth, link = flag(smooth, "smooth"), flag(link, "link")
     frames = source if isinstance(source, FrameSource) else FrameSource(source)
-    dets = load_detections(detections, det_scale) if detections is not None else None
+    dets = None
+    if detections is not None:
+        from pftrack.io.mot import zero_based_note
+
+        dets = load_detections(detections, det_scale)
+        # as pftrack track says it: a file numbered from 0 without a frame-0 row has every
+        # box drawn on the frame before its own, and nothing else tells
+        held = (f for f, d in dets.items() if len(d))
+        base = zero_based_note(held, frames.counted_frames, detections)
+        if base is not None:
+            warn(base)
     return track_frames(
         frames,
         detections=dets,
