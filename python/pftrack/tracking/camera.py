@@ -39,6 +39,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import cv2
 import numpy as np
@@ -165,6 +166,7 @@ def _grey(frame: NDArray[np.uint8], factor: float) -> NDArray[np.uint8]:
     # (_core.grey_halved: OpenCV's two calls to the bit, without the full-size grey frame)
     halves = (w >= 4 * size[0] and h >= 4 * size[1]) or (w, h) == (2 * size[0], 2 * size[1])
     packed = frame.strides[1:] == (3, 1) and frame.strides[0] > 0  # the kernel's layout
+    g: NDArray[Any]  # uint8; cv2's stubs say MatLike
     if halves and packed and _fused_grey():
         g = _core.grey_halved(frame)
     else:
@@ -186,7 +188,8 @@ def _fused_grey() -> bool:
     on 128 x 128 seeded random colours, about 0.3 ms.
     """
     frame = np.random.default_rng(0).integers(0, 256, (128, 128, 3), dtype=np.uint8)
-    want = cv2.resize(cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY), (64, 64), interpolation=cv2.INTER_AREA)
+    grey = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+    want = cv2.resize(grey, (64, 64), interpolation=cv2.INTER_AREA)
     return bool(np.array_equal(_core.grey_halved(frame), want))
 
 
