@@ -61,8 +61,9 @@ inline void resample_systematic_in_place(Eigen::Ref<RowMatrixXd> particles,
     const IndexVector idx = systematic_resample(weights, rng.uniform(~std::uint64_t(0)));
     const Index n = particles.rows();
     kept.resize(n, kParticleCols);
-    // rows of kParticleCols doubles copied as bytes (Eigen's row assignment of a Ref with an
-    // outer stride cost about 70 instructions a particle, twice the copy): the same values
+    // rows of kParticleCols doubles copied as bytes: the same values, where Eigen's row
+    // assignment through a Ref with an outer stride cost 0.15 M instructions of the bench's
+    // 11.8 M an update (docs/results.md, "Cost of update at stop 73")
     constexpr size_t kRowBytes = kParticleCols * sizeof(double);
     const Index ld = particles.outerStride();
     double* rows = particles.data();
