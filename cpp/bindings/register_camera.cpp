@@ -49,6 +49,27 @@ int point_count(const PointsF32& pts, const char* fn, const char* what) {
 
 void register_camera(py::module_& m) {
     m.def(
+        "grey_halved",
+        [](const py::object& frame_in) {
+            const char* fn = "grey_halved";
+            const py::array frame = bind::bgr_image(frame_in, fn, "frame");
+            const py::ssize_t rows = frame.shape(0) / 2, cols = frame.shape(1) / 2;
+            if (rows == 0 || cols == 0) fail(fn, "frame must be at least 2x2 pixels");
+            py::array_t<std::uint8_t> out({rows, cols});
+            const auto* in = static_cast<const std::uint8_t*>(frame.data());
+            const std::ptrdiff_t stride = frame.strides(0);
+            std::uint8_t* o = out.mutable_data();
+            {
+                py::gil_scoped_release nogil;  // safe: `frame` and `out` are held above
+                grey_halved(in, stride, static_cast<int>(rows), static_cast<int>(cols), o,
+                            static_cast<std::ptrdiff_t>(cols));
+            }
+            return out;
+        },
+        py::arg("frame"),
+        "Grey (H // 2, W // 2) uint8 of BGR frame (H, W, 3) uint8: OpenCV's cvtColor to grey "
+        "then INTER_AREA halving of the even part, to the bit, in one pass.");
+    m.def(
         "still_flow",
         [](const py::object& prev_in, const py::object& next_in, const PointsF32& pts,
            int win_size, int max_count, double epsilon, double min_eig) {

@@ -632,3 +632,4 @@ def still_flow(
     min_eig: float = 1e-4,
 ) -> tuple[NDArray[np.float32], NDArray[np.bool_]]: ...  # places (N, 2), followed (N,)
 def similarity_fit(src: ArrayLike, dst: ArrayLike) -> _F64 | None: ...  # (2, 3)
+def grey_halved(frame: NDArray[np.uint8]) -> NDArray[np.uint8]: ...  # (H, W, 3) -> (H // 2, W // 2)

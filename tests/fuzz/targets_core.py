@@ -692,6 +692,7 @@ TARGETS: list[Target] = [
     Target("padded_assignment", _padded_assignment()),
     Target("still_flow", _still_flow()),
     Target("similarity_fit", _similarity_fit()),
+    Target("grey_halved", call(_core.grey_halved, st.one_of(frames(), garbage()))),
     Target(
         "refine_boxes",
         call(

@@ -13,6 +13,15 @@
 #include <emmintrin.h>
 #endif
 
+// grey_halved's AVX2 pass, chosen at run time (the CPU's flag and background.hpp's
+// detail::avx2_allowed, which a test turns off to hold the portable loop to the same reference)
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
+#define PFTRACK_GREY_AVX2 1
+#include <immintrin.h>
+
+#include "pftrack/background.hpp"
+#endif
+
 namespace pftrack {
 
 /// A grey uint8 image: `rows` x `cols` pixels, row `r` at `data + r * stride`.
@@ -464,6 +473,108 @@ inline bool similarity_fit(const float* src, const float* dst, int n, double* ou
     out[4] = a;
     out[5] = mY - (b * mx + a * my);
     return true;
+}
+
+namespace grey_detail {
+
+// OpenCV's BGR -> grey of 8-bit pixels (cvtColor COLOR_BGR2GRAY in OpenCV 5: 0.114 B + 0.587 G
+// + 0.299 R in 15-bit fixed point, rounded), the same integer for all 2^24 colours (tested);
+// camera.py checks it against the cv2 it runs with before taking this path.
+constexpr int kGreyB = 3735, kGreyG = 19235, kGreyR = 9798, kGreyShift = 15;
+
+inline int grey_of(const std::uint8_t* px) {
+    return (px[0] * kGreyB + px[1] * kGreyG + px[2] * kGreyR + (1 << (kGreyShift - 1))) >> kGreyShift;
+}
+
+/// Output pixels [from, n) of one row of grey_halved: rows `a` and `b` of BGR pixels.
+inline void halved_row_scalar(const std::uint8_t* a, const std::uint8_t* b, int from, int n,
+                              std::uint8_t* out) {
+    for (int x = from; x < n; ++x) {
+        const std::uint8_t* p = a + 6 * x;
+        const std::uint8_t* q = b + 6 * x;
+        // resize INTER_AREA by exactly 2 (OpenCV's fast area path): (sum of 4 + 2) >> 2
+        out[x] = static_cast<std::uint8_t>(
+            (grey_of(p) + grey_of(p + 3) + grey_of(q) + grey_of(q + 3) + 2) >> 2);
+    }
+}
+
+#ifdef PFTRACK_GREY_AVX2
+/// The greys of 8 BGR pixels at `px` (24 bytes, no more read) in 32-bit lanes, in order: pixels
+/// 0-3 from the low 16 bytes, 4-7 from bytes 8-23, each lane's bytes spread by one shuffle
+/// into (B, G) and (R, 1) 16-bit pairs, whose multiply-adds give grey_of's sums.
+__attribute__((target("avx2"), always_inline)) inline __m256i grey8_avx2(const std::uint8_t* px) {
+    const __m256i v = _mm256_inserti128_si256(
+        _mm256_castsi128_si256(_mm_loadu_si128(reinterpret_cast<const __m128i*>(px))),
+        _mm_loadu_si128(reinterpret_cast<const __m128i*>(px + 8)), 1);
+    const __m256i bg_at = _mm256_setr_epi8(0, -1, 1, -1, 3, -1, 4, -1, 6, -1, 7, -1, 9, -1, 10, -1,
+                                           4, -1, 5, -1, 7, -1, 8, -1, 10, -1, 11, -1, 13, -1, 14, -1);
+    const __m256i r_at = _mm256_setr_epi8(2, -1, -1, -1, 5, -1, -1, -1, 8, -1, -1, -1, 11, -1, -1, -1,
+                                          6, -1, -1, -1, 9, -1, -1, -1, 12, -1, -1, -1, 15, -1, -1, -1);
+    const __m256i bg = _mm256_shuffle_epi8(v, bg_at);
+    const __m256i r1 = _mm256_or_si256(_mm256_shuffle_epi8(v, r_at), _mm256_set1_epi32(1 << 16));
+    const __m256i sum = _mm256_add_epi32(
+        _mm256_madd_epi16(bg, _mm256_set1_epi32(kGreyB | (kGreyG << 16))),
+        _mm256_madd_epi16(r1, _mm256_set1_epi32(kGreyR | ((1 << (kGreyShift - 1)) << 16))));
+    return _mm256_srli_epi32(sum, kGreyShift);
+}
+
+/// The 2x2 sums of 8 output pixels (16 input pixels of rows `a` and `b`, 48 bytes each, nothing
+/// past them read), in 32-bit lanes in the order 0, 1, 4, 5 | 2, 3, 6, 7 (hadd pairs within
+/// each 128-bit lane).
+__attribute__((target("avx2"), always_inline)) inline __m256i sums8_avx2(const std::uint8_t* a,
+                                                                        const std::uint8_t* b) {
+    const __m256i v0 = _mm256_add_epi32(grey8_avx2(a), grey8_avx2(b));            // pixels 0-7
+    const __m256i v1 = _mm256_add_epi32(grey8_avx2(a + 24), grey8_avx2(b + 24));  // 8-15
+    return _mm256_hadd_epi32(v0, v1);
+}
+
+/// halved_row_scalar's first output pixels, 16 a step (32 input pixels of each row, 96 bytes,
+/// nothing past them read); returns how many were written.
+__attribute__((target("avx2"))) inline int halved_row_avx2(const std::uint8_t* a,
+                                                          const std::uint8_t* b, int n,
+                                                          std::uint8_t* out) {
+    // after the packs, the low 16 bytes hold outputs 0 1 4 5 8 9 12 13 | 2 3 6 7 10 11 14 15
+    const __m128i order = _mm_setr_epi8(0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15);
+    const __m256i two = _mm256_set1_epi16(2);
+    int x = 0;
+    for (; x + 16 <= n; x += 16) {
+        const std::uint8_t* p = a + 6 * x;
+        const std::uint8_t* q = b + 6 * x;
+        // sums of four greys are at most 1020: 16-bit lanes from here, rounded as (s + 2) >> 2
+        const __m256i s = _mm256_packus_epi32(sums8_avx2(p, q), sums8_avx2(p + 48, q + 48));
+        const __m256i m = _mm256_srli_epi16(_mm256_add_epi16(s, two), 2);
+        const __m256i bytes = _mm256_permute4x64_epi64(_mm256_packus_epi16(m, m), 0x08);
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(out + x),
+                         _mm_shuffle_epi8(_mm256_castsi256_si128(bytes), order));
+    }
+    return x;
+}
+#endif
+
+}  // namespace grey_detail
+
+/// The BGR image `bgr` (rows of 3-byte pixels, row r at bgr + r * stride) in grey and halved:
+/// out (out_rows, out_cols, rows out_stride apart) is OpenCV's cv2.resize(cv2.cvtColor(bgr,
+/// COLOR_BGR2GRAY)[:2 out_rows, :2 out_cols], (out_cols, out_rows), INTER_AREA) to the bit,
+/// in one pass without the full-size grey image (the camera check's scaled frame: 0.6 M
+/// instructions a 480 x 360 frame in OpenCV's two calls). The input holds at least 2 out_rows
+/// rows of 2 out_cols pixels.
+inline void grey_halved(const std::uint8_t* bgr, std::ptrdiff_t stride, int out_rows, int out_cols,
+                        std::uint8_t* out, std::ptrdiff_t out_stride) {
+#ifdef PFTRACK_GREY_AVX2
+    const bool avx2 = __builtin_cpu_supports("avx2") &&
+                      detail::avx2_allowed().load(std::memory_order_relaxed);
+#endif
+    for (int y = 0; y < out_rows; ++y) {
+        const std::uint8_t* a = bgr + static_cast<std::ptrdiff_t>(2 * y) * stride;
+        const std::uint8_t* b = a + stride;
+        std::uint8_t* o = out + static_cast<std::ptrdiff_t>(y) * out_stride;
+        int x = 0;
+#ifdef PFTRACK_GREY_AVX2
+        if (avx2) x = grey_detail::halved_row_avx2(a, b, out_cols, o);
+#endif
+        grey_detail::halved_row_scalar(a, b, x, out_cols, o);
+    }
 }
 
 }  // namespace pftrack
