@@ -31,9 +31,9 @@ namespace pftrack {
 namespace detail {
 
 /// Whether this file's hand-written AVX2 passes may run where the CPU has AVX2
-/// (`background_row_fused_avx2`, `HsvLut::bins_of_row`, and so `hsv_bins_image`'s): true unless
-/// a test turns it off (`pftrack._core._set_avx2`) to hold the portable loops, which other CPUs
-/// run, to the same reference on the same machine.
+/// (`background_row_fused_avx2`, `histogram_row_avx2`, `HsvLut::bins_of_row`, and so
+/// `hsv_bins_image`'s): true unless a test turns it off (`pftrack._core._set_avx2`) to hold the
+/// portable loops, which other CPUs run, to the same reference on the same machine.
 inline std::atomic<bool>& avx2_allowed() {
     static std::atomic<bool> allowed{true};
     return allowed;
