@@ -513,7 +513,7 @@ void register_detection(py::module_& m) {
         [](bool allowed) { return detail::avx2_allowed().exchange(allowed); },
         py::arg("allowed"),
         "Testing hook: whether background.hpp's hand-written AVX2 passes may run (BackgroundModel."
-        "apply's row pass, hsv_bins' rows; morphology.hpp's packed masks: clean_mask, open_mask, "
+        "apply's row pass and difference histogram, hsv_bins' rows; morphology.hpp's packed masks: clean_mask, open_mask, "
         "close_mask; where the CPU has AVX2; the portable loops otherwise, "
         "the same results). Returns the previous setting; process-wide.");
 

@@ -188,6 +188,56 @@ def test_rows_without_bins_or_hold_match_the_reference(cols, kw, avx2_rows):
     assert n_moved > 0 or cols < 30
 
 
+def _difference_counts(frame: np.ndarray, background: np.ndarray) -> np.ndarray:
+    """NumPy's histogram of floor(max_c |frame_c - background_c|), clipped to 255."""
+    d = np.abs(frame.astype(np.float32) - background).max(axis=2)
+    return np.bincount(np.minimum(d.astype(np.int32), 255).ravel(), minlength=256)
+
+
+def _difference_frames(cols: int) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """(name, frame, background) pairs whose floor(d_bg) are set value by value."""
+    rng = np.random.default_rng(cols)
+    rows = 37
+    zero = np.zeros((rows, cols, 3), np.float32)
+    flat = np.arange(rows * cols).reshape(rows, cols)
+
+    def frame_of(d: np.ndarray) -> np.ndarray:
+        f = np.zeros((rows, cols, 3), np.uint8)
+        f[..., 1] = d  # d_bg is the largest channel's difference: G alone against 0
+        return f
+
+    small = rng.integers(0, 8, size=(rows, cols))
+    mixed = np.where(rng.random((rows, cols)) < 0.05, rng.integers(8, 256, (rows, cols)), small)
+    lanes = (flat * 7 + flat // 256) % 256  # every value at every position of a 32-value step
+    quarter = np.full((rows, cols, 3), 0.25, np.float32)  # d = v - 0.25: floor v - 1 (0 at 0)
+    return [
+        # one value everywhere: a lane's 4-bit counter reaches 15 on every 15-step block
+        *[(f"all {v}", frame_of(np.full((rows, cols), v)), zero) for v in (0, 1, 6, 7, 8, 255)],
+        ("small", frame_of(small), zero),
+        ("mixed", frame_of(mixed), zero),
+        ("every value in every lane", frame_of(lanes), zero),
+        ("fractional", frame_of(mixed), quarter),
+    ]
+
+
+@pytest.mark.parametrize("cols", [1, 31, 32, 33, 479, 480, 481, 512, 961, 1000])
+def test_difference_histogram_counts_every_value(cols, avx2_rows):
+    # apply's histogram of floor(d_bg): with AVX2, 32 values a step, values 0..7 in 4-bit
+    # counters summed out every 15 steps (rows of 481 and more take two blocks or more, 961 and
+    # 1000 three), the others one by one, a row's last cols % 32 by the scalar loop; without,
+    # the scalar loop alone. Against NumPy's bincount, with and without bins (the fused row
+    # pass and the portable loops)
+    for name, frame, background in _difference_frames(cols):
+        for bins in (False, True):
+            model = _core.BackgroundModel()
+            model.set_background(background)
+            model.apply(frame, bins=bins)
+            want = _difference_counts(frame, background)
+            got = np.asarray(model.difference_histogram)
+            assert got.sum() == frame.shape[0] * cols, name
+            np.testing.assert_array_equal(got, want, err_msg=f"{name}, bins={bins}")
+
+
 def test_avx2_rows_hook_gives_the_same_pass_on_a_large_frame():
     # a 360 x 487 scene (30 steps of 16 pixels and a tail of 7 a row): the two row passes
     # give the same masks, backgrounds, histograms and thresholds frame by frame
