@@ -15,6 +15,10 @@ runs while anything may be half loaded).
 
 from __future__ import annotations
 
+TYPE_CHECKING = False  # typing's, without importing it (this module imports nothing)
+if TYPE_CHECKING:
+    from types import FrameType
+
 __all__ = [
     "IMPORT_MACHINERY",
     "Terminated",
@@ -39,24 +43,56 @@ class Terminated(KeyboardInterrupt):
 IMPORT_MACHINERY = "<frozen importlib."
 
 
+#: How long a signal put off in importlib's frames waits before its handler runs again (s).
+PUT_OFF = 0.002
+
+
 def put_off_in_imports(frame: object, signum: int) -> bool:
-    """Raise `signum` again and return True if a handler's `frame` is importlib's own.
+    """Put `signum` off and return True if a handler's `frame` is importlib's own.
 
     A signal handler that gets True returns without raising.
 
     An exception a handler raises there may be raised into C that imports and prints it (a
     traceback, then that import's own error): a late import (``import cv2`` in a command's
     body, an extension's init importing NumPy: OpenCV's ``import_array``) at the moment of a
-    Ctrl-C or a SIGTERM. The signal raised again runs the handler at the next line, outside
-    those frames once the import's frames return.
+    Ctrl-C or a SIGTERM. The handler of `signum` runs again :data:`PUT_OFF` seconds later, from
+    a one-shot timer (SIGALRM), at whatever line the main thread then stands on; in importlib's
+    frames again, it is put off again. Was: the signal raised again at once, which Python
+    handles inside ``signal.raise_signal``, within the same import's frames (the traceback came
+    back, one frame deeper: CI, 7 December). Where there is no such timer (Windows), it is
+    raised again at once, as before.
     """
     code = getattr(frame, "f_code", None)
     if code is None or not code.co_filename.startswith(IMPORT_MACHINERY):
         return False
     import signal  # loaded: a handler was set with it
 
-    signal.raise_signal(signum)
+    if not hasattr(signal, "setitimer"):
+        signal.raise_signal(signum)
+        return True
+    _put_off.add(signum)
+    if signal.getsignal(signal.SIGALRM) is not _again:
+        previous = signal.signal(signal.SIGALRM, _again)
+        _alarm_before[0] = signal.SIG_DFL if previous is None else previous
+    signal.setitimer(signal.ITIMER_REAL, PUT_OFF)
     return True
+
+
+_put_off: set[int] = set()  # the signals put_off_in_imports holds, run by _again
+_alarm_before: list[object] = [None]  # SIGALRM's handler before _again, set back by it
+
+
+def _again(_alarm: int, frame: FrameType | None) -> None:
+    """The timer's end: each signal put off runs its handler now, at the main thread's line."""
+    import signal
+
+    signal.signal(signal.SIGALRM, _alarm_before[0])  # type: ignore[arg-type]
+    held = sorted(_put_off)
+    _put_off.clear()
+    for signum in held:
+        handler = signal.getsignal(signum)
+        if callable(handler):
+            handler(signum, frame)
 
 
 _interrupted = [False]
