@@ -236,13 +236,21 @@ def long_holes(rows: F64, max_gap: int) -> tuple[int, int]:
     longest : int
         The missing frames of the longest of them (0 without one).
     """
-    a = np.asarray(rows, dtype=np.float64)
-    if len(a) < 2:
-        return 0, 0
-    a = a[np.lexsort((a[:, 0], a[:, 1]))]  # by id, then frame
-    missing = np.diff(a[:, 0]) - 1
-    missing = missing[(a[1:, 1] == a[:-1, 1]) & (missing > max_gap)]
+    _, missing = _missing_after(np.asarray(rows, dtype=np.float64))
+    missing = missing[missing > max_gap]
     return len(missing), int(missing.max()) if len(missing) else 0
+
+
+def _missing_after(a: F64) -> tuple[F64, NDArray[np.float64]]:
+    """`a` by id then frame, and the frames missing after each row before its id's next.
+
+    -1 where the next row is another id's: the one walk of :func:`long_holes`,
+    :func:`short_holes` and :func:`side_frames`.
+    """
+    a = a[np.lexsort((a[:, 0], a[:, 1]))]
+    missing = np.diff(a[:, 0]) - 1
+    missing[a[1:, 1] != a[:-1, 1]] = -1
+    return a, missing
 
 
 def unfilled_note(count: int, longest: int, max_gap: int) -> str:
@@ -264,12 +272,8 @@ def short_holes(rows: F64, max_gap: int) -> int:
     `max_gap`, these are the holes :func:`jump_holes` left (every other one is filled): what
     ``pftrack smooth`` counts, as its fill's report is not returned.
     """
-    a = np.asarray(rows, dtype=np.float64)
-    if len(a) < 2:
-        return 0
-    a = a[np.lexsort((a[:, 0], a[:, 1]))]  # by id, then frame
-    missing = np.diff(a[:, 0]) - 1
-    return int(np.count_nonzero((a[1:, 1] == a[:-1, 1]) & (missing >= 1) & (missing <= max_gap)))
+    _, missing = _missing_after(np.asarray(rows, dtype=np.float64))
+    return int(np.count_nonzero((missing >= 1) & (missing <= max_gap)))
 
 
 def jump_holes(r: F64, holes: NDArray[np.int64]) -> F64:
@@ -426,12 +430,8 @@ def side_frames(rows: ArrayLike, max_gap: int) -> set[int]:
     to decode its video once. The holes a join of the linker makes have the joined
     fragments' ends as sides, which ``link_frames`` holds.
     """
-    a = check_rows(rows, "side_frames")
-    if not len(a):
-        return set()
-    r = a[np.lexsort((a[:, 0], a[:, 1]))]
-    step = np.diff(r[:, 0])
-    hole = np.flatnonzero((r[1:, 1] == r[:-1, 1]) & (step > 1) & (step <= max_gap + 1))
+    r, missing = _missing_after(check_rows(rows, "side_frames"))
+    hole = np.flatnonzero((missing >= 1) & (missing <= max_gap))
     return set((r[hole, 0].astype(np.int64) - 1).tolist()) | set(
         (r[hole + 1, 0].astype(np.int64) - 1).tolist()
     )
