@@ -26,7 +26,7 @@ from pftrack.recovery.linking import (
     link_frames,
     split_tracks,
 )
-from pftrack.synthetic import make_scene
+from pftrack.synthetic import Scene, make_scene
 
 
 class _Counted(Sequence[np.ndarray]):
@@ -44,16 +44,22 @@ class _Counted(Sequence[np.ndarray]):
         return self.frames[k]
 
 
-def _fragments() -> tuple[list[np.ndarray], np.ndarray]:
-    """make_scene's walkers, their rows behind the lamp post dropped, and each piece after a
-    hole of 5 frames or more given a new id (a tracker's fragments for the linker); then a
-    tenth of the rows dropped: short holes inside the ids (for the fill)."""
+def _behind_post() -> tuple[Scene, np.ndarray]:
+    """make_scene's walkers (120 frames, seed 0) and their truth, the rows behind the lamp
+    post dropped: holes inside the ids."""
     scene = make_scene(n_frames=120, rng=0)
     assert scene.occluder is not None
     x, _, w, _ = scene.occluder
     rows = scene.truth.copy()
     centre = rows[:, 2] + 0.5 * rows[:, 4]
-    rows = rows[(centre < x - 5) | (centre > x + w + 5)]
+    return scene, rows[(centre < x - 5) | (centre > x + w + 5)]
+
+
+def _fragments() -> tuple[list[np.ndarray], np.ndarray]:
+    """:func:`_behind_post`'s rows, each piece after a hole of 5 frames or more given a new id
+    (a tracker's fragments for the linker); then a tenth of the rows dropped: short holes
+    inside the ids (for the fill)."""
+    scene, rows = _behind_post()
     rows = rows[np.lexsort((rows[:, 0], rows[:, 1]))]
     step = np.diff(rows[:, 0])
     same = rows[1:, 1] == rows[:-1, 1]

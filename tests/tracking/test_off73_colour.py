@@ -19,10 +19,9 @@ from pftrack.recovery.linking import (
     link_frames,
     link_tracklets,
 )
-from pftrack.synthetic import make_scene
 from pftrack.tracking import smooth_tracks
 from tests.recovery.test_hand72_swap import _handed_over, _walkers
-from tests.recovery.test_off73_one_pass import _Counted, _fragments
+from tests.recovery.test_off73_one_pass import _behind_post, _Counted, _fragments
 
 HOLE = range(10, 14)
 
@@ -60,12 +59,7 @@ def test_walkers_behind_the_lamp_post_are_filled_and_linked_alike() -> None:
     after a long hole a new id (fragments for the linker): with the frames, every hole the
     pass fills without colour is filled, and read through one decode the result is the
     same (:class:`~pftrack.recovery.linking.BoxColours`)."""
-    scene = make_scene(n_frames=120, rng=0)
-    assert scene.occluder is not None
-    x, _, w, _ = scene.occluder
-    rows = scene.truth.copy()
-    centre = rows[:, 2] + 0.5 * rows[:, 4]
-    rows = rows[(centre < x - 5) | (centre > x + w + 5)]
+    scene, rows = _behind_post()
     plain = smooth_tracks(rows)
     coloured = smooth_tracks(rows, frames=scene.frames)
     assert np.array_equal(coloured, plain)
