@@ -39,6 +39,14 @@ inline std::atomic<bool>& avx2_allowed() {
     return allowed;
 }
 
+#ifdef PFTRACK_LUT_GATHER
+/// Whether an AVX2 pass (this file's, camera.hpp's `grey_halved`) runs now: the CPU has AVX2
+/// and no test turned the passes off (`avx2_allowed`).
+inline bool avx2_usable() {
+    return __builtin_cpu_supports("avx2") && avx2_allowed().load(std::memory_order_relaxed);
+}
+#endif
+
 }  // namespace detail
 
 /// `hsv_bin_of` as table look-ups, without branches: identical results (tests check all 2^24
@@ -98,9 +106,7 @@ public:
     /// the caller then takes `hsv_row_indices` and `bin_at`.
     bool bins_of_row(Index n, const std::uint8_t* px, std::int16_t* out) const {
 #ifdef PFTRACK_LUT_GATHER
-        if (!__builtin_cpu_supports("avx2") ||
-            !detail::avx2_allowed().load(std::memory_order_relaxed))
-            return false;
+        if (!detail::avx2_usable()) return false;
         Index x = bins_of_row_avx2(n, px, out);
         for (; x < n; ++x)
             out[x] = static_cast<std::int16_t>(bin(px[3 * x], px[3 * x + 1], px[3 * x + 2]));
@@ -808,8 +814,7 @@ public:
         std::uint64_t small[detail::kSmallBins / 2][2][4] = {};
         bool hist_avx2 = false;
 #ifdef PFTRACK_LUT_GATHER
-        hist_avx2 = __builtin_cpu_supports("avx2") &&
-                    detail::avx2_allowed().load(std::memory_order_relaxed);
+        hist_avx2 = detail::avx2_usable();
 #endif
         const Index n3 = cols * 3;
         const auto ns = static_cast<size_t>(cols);
@@ -832,8 +837,7 @@ public:
         // of every pixel) and without a hold row (its update reads the candidate flags)
         bool fused = false;
 #ifdef PFTRACK_LUT_GATHER
-        fused = bins == nullptr && hold == nullptr && __builtin_cpu_supports("avx2") &&
-                detail::avx2_allowed().load(std::memory_order_relaxed);
+        fused = bins == nullptr && hold == nullptr && detail::avx2_usable();
 #endif
         // Each row in three or four loops over L1-resident row buffers: (1), (2), (3) are
         // vectorised by the compiler (the shadow test of (2) too, over every pixel of each

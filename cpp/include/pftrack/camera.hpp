@@ -562,8 +562,7 @@ __attribute__((target("avx2"))) inline int halved_row_avx2(const std::uint8_t* a
 inline void grey_halved(const std::uint8_t* bgr, std::ptrdiff_t stride, int out_rows, int out_cols,
                         std::uint8_t* out, std::ptrdiff_t out_stride) {
 #ifdef PFTRACK_GREY_AVX2
-    const bool avx2 = __builtin_cpu_supports("avx2") &&
-                      detail::avx2_allowed().load(std::memory_order_relaxed);
+    const bool avx2 = detail::avx2_usable();
 #endif
     for (int y = 0; y < out_rows; ++y) {
         const std::uint8_t* a = bgr + static_cast<std::ptrdiff_t>(2 * y) * stride;
