@@ -328,7 +328,7 @@ class BoxColours(Sequence[NDArray[np.uint8]]):
         self._boxes = boxes
         self._hists = frame_histograms(boxes, frames)
         # each frame's boxes by value: a reader asks for a box by its four numbers
-        self._index = {f: {b.tobytes(): k for k, b in enumerate(v)} for f, v in boxes.items()}
+        self._index = {f: {_key(b): k for k, b in enumerate(v)} for f, v in boxes.items()}
 
     def __len__(self) -> int:
         return len(self.frames)
@@ -348,26 +348,23 @@ class BoxColours(Sequence[NDArray[np.uint8]]):
         `wanted` missed it), so the answer never depends on what was read.
         """
         out: dict[int, F64 | None] = {}
-        missing: dict[int, F64] = {}
+        missing: dict[int, F64] = {}  # frame_histograms' own answer (no box or no frame: no read)
         for f, b in boxes.items():
             h, index = self._hists.get(f), self._index.get(f)
-            if not len(b):
-                out[f] = None if not 0 <= f < len(self) else np.zeros((0, 0))
-                continue
-            if f not in self._hists or index is None:
-                missing[f] = b
-                continue
-            if h is None:
-                out[f] = None
-                continue
-            rows = [index.get(np.ascontiguousarray(x, dtype=np.float64).tobytes()) for x in b]
-            if any(k is None for k in rows):
-                missing[f] = b
-                continue
-            out[f] = h[np.array(rows, dtype=np.intp)]
+            if h is not None and index is not None and len(b):
+                at = [index.get(_key(x)) for x in b]
+                if None not in at:
+                    out[f] = h[np.array(at, dtype=np.intp)]
+                    continue
+            missing[f] = b
         if missing:
             out.update(frame_histograms(missing, self.frames))
         return out
+
+
+def _key(box: F64) -> bytes:
+    """A box's four numbers as :class:`BoxColours` looks it up."""
+    return np.ascontiguousarray(box, dtype=np.float64).tobytes()
 
 
 def link_frames(rows: ArrayLike, config: LinkConfig) -> set[int]:
