@@ -292,12 +292,13 @@ def run(args: argparse.Namespace) -> int:
         staged_outputs,
         writes_through,
     )
-    from pftrack.io.mot import format_mot_row, write_mot, zero_based_note
+    from pftrack.io.mot import format_mot_row, write_mot
     from pftrack.io.video import FrameSource, check_source, gap_note, is_live_source
     from pftrack.io.video_writer import VIDEO_SUFFIXES, check_frame_size
     from pftrack.recovery import LinkConfig
     from pftrack.render import TrackRenderer, paths_title, plot_trajectories
     from pftrack.tracking import BoxSmoother, load_detections
+    from pftrack.tracking.run import say_zero_based
 
     opencv_single_threaded()
 
@@ -374,12 +375,7 @@ def run(args: argparse.Namespace) -> int:
                         # and a ground truth numbered by the names scored them shifted
                         warn(gap)
                     if det_path is not None and dets is not None:
-                        # was said nowhere: a file numbered from 0 without a frame-0 row had
-                        # every box drawn on the frame before its own
-                        held = (f for f, d in dets.items() if len(d))
-                        base = zero_based_note(held, source.counted_frames, det_path)
-                        if base is not None:
-                            warn(base)
+                        say_zero_based(dets, source.counted_frames, det_path)
                     result = _track(
                         live,
                         first,

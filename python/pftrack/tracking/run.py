@@ -832,6 +832,19 @@ def _check_layout(
         )
 
 
+def say_zero_based(detections: Mapping[int, F64], n_frames: int, path: object) -> None:
+    """Warn when :func:`load_detections`' file looks numbered from 0 without a frame-0 row.
+
+    Every box would be drawn on the frame before its own, and nothing else tells
+    (:func:`pftrack.io.mot.zero_based_note`); ``pftrack track`` and :func:`track_path` say it.
+    """
+    from pftrack.io.mot import zero_based_note
+
+    base = zero_based_note((f for f, d in detections.items() if len(d)), n_frames, path)
+    if base is not None:
+        warn(base)
+
+
 def track_path(
     source: PathLike | FrameSource,
     *,
@@ -880,15 +893,8 @@ def track_path(
     frames = source if isinstance(source, FrameSource) else FrameSource(source)
     dets = None
     if detections is not None:
-        from pftrack.io.mot import zero_based_note
-
         dets = load_detections(detections, det_scale)
-        # as pftrack track says it: a file numbered from 0 without a frame-0 row has every
-        # box drawn on the frame before its own, and nothing else tells
-        held = (f for f, d in dets.items() if len(d))
-        base = zero_based_note(held, frames.counted_frames, detections)
-        if base is not None:
-            warn(base)
+        say_zero_based(dets, frames.counted_frames, detections)
     return track_frames(
         frames,
         detections=dets,
