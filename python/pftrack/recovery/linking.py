@@ -48,6 +48,7 @@ __all__ = [
     "FLAG_COLUMN",
     "MAX_ID",
     "BoxColours",
+    "RowColours",
     "LinkConfig",
     "box_centres",
     "check_boxes",
@@ -359,6 +360,60 @@ class BoxColours(Sequence[NDArray[np.uint8]]):
             missing[f] = b
         if missing:
             out.update(frame_histograms(missing, self.frames))
+        return out
+
+
+class RowColours(BoxColours):
+    """Colour histograms given per row (a tracker's own), answered as :class:`BoxColours` does.
+
+    Stands for `frames` in the readers of :func:`frame_histograms` (the linker's colour term,
+    the fill's swap rule) when the histograms are known already: each row's histogram is the
+    answer for its boxes at its frame, so no frame is decoded. A box of no row, or a row whose
+    histogram is all zeros, gets a row of zeros: nothing to count, which the readers do not
+    judge (a hole side without colour, a fragment end without colour cost).
+
+    Parameters
+    ----------
+    rows : (M, >=6) ndarray
+        Rows ``frame, id, left, top, width, height, ...``.
+    histograms : (M, B) ndarray
+        Each row's histogram (zeros: none).
+    boxes : (M, 4) ndarray, optional
+        Other boxes of the same rows with the same histograms (e.g. the measured ones the
+        fill reads, where the rows hold filtered boxes).
+    """
+
+    def __init__(self, rows: F64, histograms: F64, boxes: F64 | None = None) -> None:
+        self.frames: Sequence[NDArray[np.uint8]] = ()
+        self._bins = histograms.shape[1]
+        fr = rows[:, 0].astype(np.int64) - 1
+        self._last = int(fr.max()) + 1 if len(fr) else 0
+        index: dict[int, dict[bytes, int]] = {}
+        sets = [rows[:, 2:6]] if boxes is None else [rows[:, 2:6], boxes]
+        for b in sets:
+            for k, (f, x) in enumerate(zip(fr.tolist(), b, strict=True)):
+                index.setdefault(f, {}).setdefault(_key(x), k)  # a box's first row answers
+        self._index = index
+        self._rows_hists = histograms
+
+    def __len__(self) -> int:
+        return self._last
+
+    def __getitem__(self, k: int | slice) -> Any:
+        """No frame is held: the histograms are the rows'."""
+        raise IndexError("RowColours holds histograms, not frames")
+
+    def histograms(self, boxes: dict[int, F64]) -> dict[int, F64 | None]:
+        """Each box's row's histogram at its 0-based frame (zeros where no row has it)."""
+        out: dict[int, F64 | None] = {}
+        for f, b in boxes.items():
+            index = self._index.get(f, {})
+            h = np.zeros((len(b), self._bins))
+            for k, x in enumerate(b):
+                at = index.get(_key(x))
+                if at is not None:
+                    h[k] = self._rows_hists[at]
+            out[f] = h
         return out
 
 

@@ -847,6 +847,7 @@ class Tracker:
         smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
         link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
         prime_frames: IntLike = PRIME_FRAMES,
+        colour: str | None = None,
     ) -> Tracker:
         """A tracker from a full :class:`TrackerConfig` (frame-based), as ``pftrack track`` makes.
 
@@ -865,6 +866,9 @@ class Tracker:
             The offline pass (None: off).
         prime_frames : int
             Frames :meth:`prime` reads.
+        colour : {"swap", "link", "both"} or None
+            The tracker's own histograms of its rows kept and handed to the offline pass
+            (:class:`TrackWriter`'s ``colour``); None (default): no colour there.
         """
         self = cls.__new__(cls)
         self._setup(
@@ -876,12 +880,14 @@ class Tracker:
             link=link,
             prime_frames=prime_frames,
             coasting=coasting,
+            colour=colour,
         )
         return self
 
     def _setup(self, config: TrackerConfig, seed: RngLike, *, frame_rate: RealLike, fill: str,
                smoother: BoxSmoother | None, link: LinkConfig | None, prime_frames: IntLike,
-               coasting: str = "confirmed", record: bool = True) -> None:  # fmt: skip
+               coasting: str = "confirmed", record: bool = True,
+               colour: str | None = None) -> None:  # fmt: skip
         if seed is not None and not isinstance(seed, (int, np.integer, np.random.Generator)):
             raise TypeError(f"seed must be an int, a Generator or None, got {type(seed).__name__}")
         if not isinstance(config, TrackerConfig):
@@ -898,7 +904,7 @@ class Tracker:
         self.seed = seed
         self.prime_frames = int(prime_frames)
         self.record = record
-        self._writer_args = (coasting, fill, smoother, link)
+        self._writer_args = (coasting, fill, smoother, link, colour)  # colour: stop 74
         TrackWriter(*self._writer_args)  # check the writer's options now
         self._busy = threading.Lock()
         self.reset()

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pftrack import _check
-from pftrack._check import MAX_FRAME, brief, real_array, shown
+from pftrack._check import MAX_FRAME, brief, option, real_array, shown
 from pftrack._progress import progress
 from pftrack._stats import median
 from pftrack._typing import F64, IntLike, RecoveryMethod
@@ -36,6 +36,7 @@ from pftrack.recovery.linking import (
     MAX_ID,
     BoxColours,
     LinkConfig,
+    RowColours,
     _pair_blocks,
     check_boxes,
     check_rows,
@@ -49,6 +50,7 @@ from pftrack.recovery.names import DEFAULT_METHOD, METHODS
 
 __all__ = [
     "AMODAL_ANCHORS",
+    "COLOUR_USES",
     "BoxSmoother",
     "CrossingConfig",
     "complete_boxes",
@@ -76,6 +78,10 @@ SIZE_ROWS: tuple[float, float] | None = (5.0, 95.0)
 SIZE_SPREADS: float | None = 2.0
 NOISE_MIN = 1e-6  # BoxSmoother's noise levels, in track heights: smaller or larger ones would
 NOISE_MAX = 1e6  # only push the smoother to its limits (a straight line, or the detections)
+
+
+#: What :func:`smooth_tracks`' colour (`frames` or `histograms`) is given to.
+COLOUR_USES = ("both", "swap", "link")
 
 
 def _check_noise_levels(owner: str, config: object, unit: str) -> None:
@@ -657,6 +663,8 @@ def smooth_tracks(
     relink_coast: int | None = None,
     max_gap: IntLike | None = None,
     frames: Sequence[NDArray[np.uint8]] | None = None,
+    histograms: ArrayLike | None = None,
+    colour: str = "both",
 ) -> F64:
     """Offline pass over any tracker's MOTChallenge rows: link fragments, fill holes, smooth.
 
@@ -718,6 +726,15 @@ def smooth_tracks(
         :func:`pftrack.recovery.fill.swap_holes`), on the boxes the smoother fits. None
         (default): motion and size only, as the tracker's own pass (docs/recovery.md,
         "Colour in the offline pass").
+    histograms : (M, B) array_like, optional
+        Each row's colour histogram, instead of `frames` (not both): a tracker's own, e.g. the
+        detection it matched (:class:`TrackWriter` with ``colour``); a row of zeros has none
+        and is not judged. Used as `frames`' histograms would be
+        (:class:`~pftrack.recovery.linking.RowColours`), for the rows' boxes and
+        `measurements` alike; no frame is read.
+    colour : {"both", "swap", "link"}
+        What the colour of `frames` or `histograms` is given to: the linker's colour term and
+        the fill's swap rule (default), the swap rule alone, or the linker alone.
 
     Returns
     -------
@@ -787,6 +804,21 @@ def smooth_tracks(
         raise ValueError(
             f"smooth_tracks: relink_coast is {brief(relink_coast)}, expected None or an int >= 1"
         )
+    option(colour, "smooth_tracks: colour", COLOUR_USES)
+    if colour not in COLOUR_USES:
+        raise ValueError(f"smooth_tracks: colour is {colour!r}, expected one of {COLOUR_USES}")
+    stored: RowColours | None = None
+    if histograms is not None:
+        if frames is not None:
+            raise ValueError("smooth_tracks: give frames or histograms, not both")
+        h = np.asarray(real_array(histograms, "smooth_tracks: histograms"), dtype=np.float64)
+        if h.ndim != 2 or len(h) != len(a):
+            raise ValueError(
+                f"smooth_tracks: histograms has shape {h.shape}, expected ({len(a)}, B)"
+            )
+        if not (h.min(initial=0.0) >= 0 and h.max(initial=0.0) < np.inf):
+            raise ValueError("smooth_tracks: histograms must be finite and >= 0")
+        stored = RowColours(a, h, z)  # looked up by box: ids change below, boxes do not
     if isinstance(link, str):  # "auto": pftrack smooth's gate, grown to the rows' frame
         link = link_config_for(a, DEFAULT_MAX_GAP if max_gap is None else max_gap)
     fill_gap = max_gap if max_gap is not None else None if link is None else link.max_gap
@@ -801,15 +833,19 @@ def smooth_tracks(
         measured = a.copy()
         measured[:, 2:6] = z
         frames = BoxColours(frames, np.vstack([a, measured]), wanted)
+    if stored is not None:
+        frames = stored
+    link_colour = frames if colour in ("both", "link") else None
+    fill_colour = frames if colour in ("both", "swap") else None
     if link is not None:
-        a, _ = link_tracklets(a, link, frames)
+        a, _ = link_tracklets(a, link, link_colour)
     if crossings is not None and crossings.enabled:
         a = repair_crossings(a, obs, crossings, z)
     order = np.lexsort((a[:, 0], a[:, 1]))  # by id, then frame
     a, obs, z = a[order], obs[order], z[order]
     new = np.zeros(len(a), dtype=bool)
     if smoother is not None and fill_gap is not None:
-        a, obs, z, new = _add_hole_rows(a, obs, z, fill_gap, fill_method, seed, frames)
+        a, obs, z, new = _add_hole_rows(a, obs, z, fill_gap, fill_method, seed, fill_colour)
         # a hole left unfilled is no bridge for the smoother either: its two sides are
         # smoothed apart (was: joined through holes of up to max_hole = 300 frames, so an id a
         # tracker gave a second, still person 41 frames later bent both people's boxes by 10 px)

@@ -91,6 +91,13 @@ class Track:
     cls : int
         Class id: that of the detection the track was born from (0 when none is given). A
         track is only ever matched to detections of its own class.
+    colour : (B,) ndarray or None
+        The colour histogram the tracker holds for this row: the matched detection's (the one
+        the association compared) when `detection_box` is given, else the particle filter's
+        reference. The offline pass may judge its holes by it (:class:`~.writer.TrackWriter`'s
+        ``colour``); None from a tracker that has none (the joint sampler).
+    history_colours : tuple of (B,) ndarray or None
+        The detections' histograms of `history`, one per entry.
     """
 
     id: int
@@ -102,6 +109,8 @@ class Track:
     history: tuple[tuple[int, F64, float], ...] = ()
     detection_box: F64 | None = None
     cls: int = 0
+    colour: F64 | None = None
+    history_colours: tuple[F64 | None, ...] = ()
 
 
 class LiveTrack:
@@ -127,6 +136,9 @@ class LiveTrack:
     #: this frame's was (:attr:`flat`). Class defaults: a checkpoint pickled before them has none.
     blind = 0
     flat = False
+    #: The last followed detection's histogram (:attr:`Track.colour`); a checkpoint pickled
+    #: before stop 74 has none.
+    seen: F64 | None = None
 
     def __init__(self, track_id: int, box_xywh: F64, reference: F64, config: TrackerConfig,
                  seed: int, score: float) -> None:  # fmt: skip
@@ -162,7 +174,9 @@ class LiveTrack:
         self.cls = 0  # class id, set by the tracker at birth
         self.measured: F64 | None = box_xywh.copy()  # this frame's detection box
         self.unreported: list[tuple[int, F64, float]] = []
+        self.unseen: list[F64 | None] = []  # the histograms of `unreported`'s boxes
         self.reported = False
+        self.seen = reference  # the detection's histogram (a row the tracker does not change)
         # coasted frames with detections in a row whose colour likelihood was flat (a blind
         # coast: the centre filter's extrapolation alone), and whether this frame's was
         self.blind = 0
@@ -285,13 +299,20 @@ class LiveTrack:
         An unconfirmed track (outside the start-up frames, `early`) keeps its detection boxes
         to hand over with its first report, as :attr:`Track.history`.
         """
+        unseen = self.__dict__.get("unseen")  # a checkpoint from before stop 74 has none
         if self.hits < rules.min_hits and not early and not self.reported:
             if self.measured is not None:
                 self.unreported.append((frame_index, self.measured.copy(), float(self.score)))
+                if unseen is not None:
+                    unseen.append(self.seen)
             return None
         if self.time_since_update > 0 and self.rho < rules.coast_min_rho:
             return None
         history, self.unreported, self.reported = tuple(self.unreported), [], True
+        colours: tuple[F64 | None, ...] = ()
+        if history:
+            colours = tuple(unseen) if unseen else (None,) * len(history)
+        self.unseen = []
         return _new_track(
             self.id,
             self.box.copy(),
@@ -302,6 +323,8 @@ class LiveTrack:
             history,
             None if self.measured is None else self.measured.copy(),
             self.cls,
+            self.filter.reference if self.measured is None else self.seen,
+            colours,
         )
 
 
@@ -322,12 +345,13 @@ def frozen_made(kind: type[_T], /, **fields: object) -> _T:
 
 def _new_track(id: int, box_xywh: F64, score: float, detection_index: int | None, age: int,
                time_since_update: int, history: tuple[tuple[int, F64, float], ...],
-               detection_box: F64 | None, cls: int) -> Track:  # fmt: skip
+               detection_box: F64 | None, cls: int, colour: F64 | None = None,
+               history_colours: tuple[F64 | None, ...] = ()) -> Track:  # fmt: skip
     """``Track(id, box_xywh, ...)`` by :func:`frozen_made`."""
     return frozen_made(
         Track, id=id, box_xywh=box_xywh, score=score, detection_index=detection_index, age=age,
         time_since_update=time_since_update, history=history, detection_box=detection_box,
-        cls=cls,
+        cls=cls, colour=colour, history_colours=history_colours,
     )  # fmt: skip
 
 
@@ -427,6 +451,8 @@ def reseed_tracks(
     """
     if not tracks:
         return
+    for t, h in zip(tracks, hists, strict=True):  # the histogram each row was matched by
+        t.seen = h
     filters = [t.filter for t in tracks]
     reinitialise_filters(filters, _to_cxcywh(boxes_xywh), np.array([t.motion.v for t in tracks]))
     rate = config.reference_rate

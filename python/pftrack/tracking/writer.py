@@ -11,7 +11,7 @@ from pftrack._check import option
 from pftrack._stats import unique_values
 from pftrack._typing import F64
 from pftrack.recovery.linking import LinkConfig
-from pftrack.tracking.offline import BoxSmoother, CrossingConfig, smooth_tracks
+from pftrack.tracking.offline import COLOUR_USES, BoxSmoother, CrossingConfig, smooth_tracks
 from pftrack.tracking.track import Track
 
 __all__ = ["TrackWriter"]
@@ -26,12 +26,19 @@ class _Rows:
     """
 
     BLOCK = 1024
+    #: Colour blocks (:meth:`colours`); a store pickled before stop 74 has none.
+    _cdone: list[F64] | None = None
+    _col: F64 | None = None
 
     def __init__(self) -> None:
         self._done: list[tuple[F64, F64, np.ndarray]] = []  # full blocks: rows, boxes, has-box
         self._new()
 
     def _new(self) -> None:
+        if self._col is not None:  # the full block's histograms, kept beside its rows
+            assert self._cdone is not None
+            self._cdone.append(self._col)
+            self._col = np.zeros_like(self._col)
         self._rows = np.empty((self.BLOCK, 10))
         self._boxes = np.zeros((self.BLOCK, 4))
         self._has = np.zeros(self.BLOCK, bool)
@@ -41,11 +48,22 @@ class _Rows:
         """Keep one row and its detection box (None: the row has none)."""
         self.extend([row], [box])
 
-    def extend(self, rows: list[list[float]], boxes: list[F64 | None]) -> None:
+    def extend(
+        self,
+        rows: list[list[float]],
+        boxes: list[F64 | None],
+        colours: list[F64 | None] | None = None,
+    ) -> None:
         """Keep each row and its box in turn, the rows of a block in one copy.
 
-        A frame's rows (one per track reported) were one NumPy assignment each.
+        A frame's rows (one per track reported) were one NumPy assignment each. `colours`
+        (one histogram or None a row) are kept too when given: :meth:`colours`.
         """
+        if colours is not None and self._col is None:
+            first = next((c for c in colours if c is not None), None)
+            if first is not None:  # the first histogram sets the bins; earlier rows had none
+                self._cdone = [np.zeros((self.BLOCK, len(first))) for _ in self._done]
+                self._col = np.zeros((self.BLOCK, len(first)))
         at = 0
         while at < len(rows):
             if self._n == self.BLOCK:
@@ -57,6 +75,10 @@ class _Rows:
                 if box is not None:
                     self._boxes[j] = box
                     self._has[j] = True
+            if colours is not None and self._col is not None:
+                for j, c in enumerate(colours[at : at + k], start=self._n):
+                    if c is not None:
+                        self._col[j] = c
             self._n += k
             at += k
 
@@ -77,6 +99,16 @@ class _Rows:
             np.concatenate([parts[0][k][cut:], *(p[k] for p in parts[1:])]) for k in range(3)
         )
         return rows, boxes, has
+
+    def colours(self) -> F64 | None:
+        """Every row's colour histogram ``(M, B)`` (zeros: none was given), or None if none was.
+
+        A copy, in the rows' order (:meth:`arrays`).
+        """
+        if self._col is None:
+            return None
+        assert self._cdone is not None
+        return np.concatenate([*self._cdone, self._col[: self._n]])
 
 
 class TrackWriter:
@@ -105,11 +137,21 @@ class TrackWriter:
         and size terms) before smoothing, so a joined track is smoothed as one; with a smoother,
         the frames missing inside a track (up to ``link.max_gap``) are then written with the
         smoother's interpolation. None keeps every id and every hole.
+    colour : {"swap", "link", "both"} or None
+        Keep the colour histogram of every row written (:attr:`Track.colour`: the matched
+        detection's, or the filter's reference) and hand them to the offline pass: the fill's
+        swap rule, the linker's colour term, or both (:func:`~.offline.smooth_tracks`'
+        ``histograms``). None (default): no colour kept or used (docs/recovery.md, "The
+        tracker's own colour in the offline pass").
     """
+
+    #: A writer pickled before stop 74 keeps no colour.
+    colour: str | None = None
 
     def __init__(self, coasting: str = "confirmed", fill: str = "linear",
                  smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen
-                 link: LinkConfig | None = LinkConfig()) -> None:  # noqa: B008  # fmt: skip
+                 link: LinkConfig | None = LinkConfig(),  # noqa: B008
+                 colour: str | None = None) -> None:  # fmt: skip
         option(coasting, "coasting", ("confirmed", "all", "none"))
         option(fill, "fill", ("linear", "pf"))
         if coasting not in ("confirmed", "all", "none"):
@@ -122,6 +164,10 @@ class TrackWriter:
             )
         if link is not None and not isinstance(link, LinkConfig):
             raise TypeError(f"link must be a LinkConfig or None, got {type(link).__name__}")
+        option(colour, "colour", (*COLOUR_USES, None))
+        if colour is not None and colour not in COLOUR_USES:
+            raise ValueError(f"colour is {colour!r}, expected one of {COLOUR_USES} or None")
+        self.colour = colour
         self.coasting = coasting
         self.fill = fill
         self.smoother = smoother
@@ -130,6 +176,7 @@ class TrackWriter:
         self._pending: dict[int, list[list[float]]] = {}
         self._last: dict[int, list[float]] = {}
         self._cls: dict[int, int] = {}  # class of each track id
+        self._held: dict[int, list[F64 | None]] = {}  # with `colour`: the held-back rows'
         self.classes: dict[int, int] = {}  # class of each id of the last result()
 
     def __setstate__(self, state: dict[str, Any]) -> None:
@@ -145,12 +192,16 @@ class TrackWriter:
         """Record the tracks reported for `frame` (1-based)."""
         rows: list[list[float]] = []  # the frame's rows in order, written at once at the end
         boxes: list[F64 | None] = []
+        keep = self.colour is not None
+        colours: list[F64 | None] = []  # with `colour`: each row's histogram
         for t in tracks:
             self._cls[t.id] = t.cls
             for f, box, score in t.history:  # a new track's detections from before confirmation
                 row = [float(f), float(t.id), *map(float, box), score, -1.0, -1.0, -1.0]
                 rows.append(row)
                 boxes.append(np.asarray(box))
+            if keep:
+                colours += t.history_colours or [None] * len(t.history)
             row = [float(frame), float(t.id), *t.box_xywh.tolist(), float(t.score)]
             row += [-1.0, -1.0, -1.0]
             if t.time_since_update == 0:
@@ -165,13 +216,20 @@ class TrackWriter:
                 rows.append(row)
                 boxes.append(t.detection_box)
                 self._last[t.id] = row
+                if keep:  # held-back rows: the reference each was reported with
+                    colours += self._held.pop(t.id, [None] * len(pending))
+                    colours.append(t.colour)
             elif self.coasting == "all":
                 rows.append(row)
                 boxes.append(None)
+                if keep:
+                    colours.append(t.colour)
             elif self.coasting == "confirmed":
                 self._pending.setdefault(t.id, []).append(row)
+                if keep:
+                    self._held.setdefault(t.id, []).append(t.colour)
         if rows:
-            self.rows.extend(rows, boxes)
+            self.rows.extend(rows, boxes, colours if keep else None)
 
     def result(self, drop: Collection[int] = (), crossings: CrossingConfig | None = None,
                relink_coast: int | None = None,
@@ -197,15 +255,19 @@ class TrackWriter:
             a, boxes, observed = a[keep], boxes[keep], observed[keep]
         if len(a) == 0:
             return np.zeros((0, 10))
+        hists = None if self.colour is None else self.rows.colours()
+        if hists is not None and len(drop):
+            hists = hists[keep]
         z = a[:, 2:6].copy()  # the smoother fits the detection boxes, not the reported ones
         z[observed] = boxes[observed]
+        use = self.colour if hists is not None else None
         cls = np.array([self._cls.get(int(i), 0) for i in a[:, 1]], np.int64)
         classes = unique_values(cls)
         if len(classes) == 1:
             smoother = own.get(int(classes[0]), self.smoother)
             rows = smooth_tracks(
                 a, observed, smoother, self.link, z, crossings=crossings,
-                relink_coast=relink_coast,
+                relink_coast=relink_coast, histograms=hists, colour=use or "both",
             )  # fmt: skip
             ids = unique_values(rows[:, 1]).astype(int).tolist()
             self.classes = dict.fromkeys(ids, int(classes[0]))
@@ -220,6 +282,8 @@ class TrackWriter:
                 a[k], observed[k], own.get(int(c), self.smoother), self.link, z[k],
                 crossings=crossings,
                 relink_coast=relink_coast,
+                histograms=None if hists is None else hists[k],
+                colour=use or "both",
             )  # fmt: skip
             new = np.setdiff1d(out[:, 1], a[k, 1])
             if len(new):
