@@ -1,11 +1,11 @@
-"""The tracker's own colour in its offline pass (stop 74; an option, off by default).
+"""The tracker's own colour in its offline pass (stop 74; the swap rule on by default).
 
-A tracker made with ``colour`` keeps, for each row it writes, the histogram it already holds
-(the matched detection's, which the association compared, or the filter's reference while
-it coasts) and hands them to :func:`pftrack.tracking.smooth_tracks` as ``histograms``: the
-fill's swap rule (:func:`pftrack.recovery.fill.swap_holes`) and the linker's colour term read
-them instead of decoding the video again (docs/recovery.md, "The tracker's own colour in the
-offline pass").
+A tracker made with ``colour`` (``"swap"`` by default) keeps, for each row it writes, the
+histogram it already holds (the matched detection's, which the association compared, or the
+filter's reference while it coasts) and hands them to :func:`pftrack.tracking.smooth_tracks`
+as ``histograms``: the fill's swap rule (:func:`pftrack.recovery.fill.swap_holes`) and, with
+``"link"``, the linker's colour term read them instead of decoding the video again
+(docs/recovery.md, "The tracker's own colour in the offline pass").
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from pftrack.recovery.linking import FLAG_COLUMN, RowColours, frame_histograms
 from pftrack.tracking import smooth_tracks
 from pftrack.tracking.track import Track
 from pftrack.tracking.writer import TrackWriter
-from tests.recovery.test_hand72_swap import _handed_over, _walkers
+from tests.recovery.test_hand72_swap import BLUE, RED, _handed_over, _walkers
 from tests.reference import kernels as ref
 
 HOLE = range(10, 14)
@@ -83,6 +83,63 @@ def test_the_same_walker_across_an_occlusion_is_still_filled() -> None:
     own = _reported(frames, rows, "both")
     assert np.array_equal(own, _reported(frames, rows, None))
     assert len(_rows_in(own, HOLE)) == 2 * len(HOLE)
+
+
+def _crossing_lanes(after: tuple[int, int, int], gap: range) -> tuple[list, np.ndarray]:
+    """A red walker on the top lane, unseen from ``gap[0]`` on; a walker of colour `after`
+    on the same path after `gap` (the same red one again, or a blue one); a red and a blue
+    walker on two other lanes, walking the other way all along. BGR frames and true rows."""
+    rng = np.random.default_rng(0)
+    floor = rng.integers(90, 150, (200, 320, 1), dtype=np.uint8).repeat(3, axis=2)
+    frames, rows = [], []
+    for f in range(1, 31):
+        image = floor.copy()
+        walkers = [(3, RED, 280 - 5 * f, 150), (4, BLUE, 280 - 5 * f, 95)]
+        if f < gap[0]:
+            walkers.append((1, RED, 20 + 6 * f, 30))
+        if f > gap[-1]:
+            walkers.append((2, after, 20 + 6 * f, 30))
+        for tid, colour, x, y in walkers:
+            image[y : y + 30, x : x + 20] = colour
+            rows.append([f, tid, x, y, 20, 30])
+        frames.append(image)
+    return frames, np.array(rows, dtype=np.float64)
+
+
+def _finalized(frames: list, truth: np.ndarray, colour: str | None) -> np.ndarray:
+    tracker = pftrack.Tracker.from_config(seed=0, colour=colour)
+    for f, frame in enumerate(frames, start=1):
+        b = truth[truth[:, 0] == f, 2:6]
+        tracker.update(
+            np.column_stack([b[:, :2], b[:, :2] + b[:, 2:], np.full(len(b), 0.95)]), frame
+        )
+    return tracker.finalize()
+
+
+@pytest.mark.parametrize("gap", [range(11, 14), range(11, 16)], ids=["tracker", "linker"])
+def test_the_trackers_hand_over_between_two_colours_is_left(gap: range) -> None:
+    """The tracker itself hands the red walker's id to the blue one that appears on its path
+    (3 frames unseen: the association; 5: a new id the offline linker joins). Without colour
+    the pass fills the hole between them; with the tracker's histograms (the swap rule) it is
+    left: the red side looks like the other red walker, the blue side like the blue one."""
+    frames, truth = _crossing_lanes(BLUE, gap)
+    plain = _finalized(frames, truth, None)
+    top = plain[plain[:, 3] < 60]  # the top lane's rows: one id across the hole
+    assert len(np.unique(top[:, 1])) == 1
+    assert (plain[:, FLAG_COLUMN] == 1).sum() == len(gap)
+    for use in ("swap", "both"):
+        own = _finalized(frames, truth, use)
+        assert not np.any(own[:, FLAG_COLUMN] == 1)
+        assert len(own) == len(plain) - len(gap)
+        assert not len(_rows_in(own[own[:, 3] < 60], gap))
+
+
+def test_the_trackers_same_walker_across_an_occlusion_is_still_filled() -> None:
+    frames, truth = _crossing_lanes(RED, range(11, 14))
+    plain = _finalized(frames, truth, None)
+    assert (plain[:, FLAG_COLUMN] == 1).sum() == 3
+    for use in ("swap", "both"):
+        assert np.array_equal(_finalized(frames, truth, use), plain)
 
 
 def test_row_colours_answer_each_rows_histogram_and_zeros_elsewhere() -> None:
@@ -162,3 +219,47 @@ def test_bad_histograms_and_options_are_refused_in_one_line() -> None:
         TrackWriter(colour="red")
     with pytest.raises(TypeError, match="colour must be"):
         TrackWriter(colour=1)  # type: ignore[arg-type]
+
+
+def test_the_default_keeps_colour_for_the_swap_rule_and_an_online_tracker_none() -> None:
+    tracker = pftrack.Tracker()
+    assert tracker._writer.colour == "swap" and tracker._tracker.keep_colour
+    assert pftrack.Tracker.from_config()._writer.colour == "swap"
+    online = pftrack.Tracker(record=False)
+    assert not online._tracker.keep_colour  # nothing kept, nothing stored
+    plain = pftrack.Tracker(colour=None)
+    assert plain._writer.colour is None and not plain._tracker.keep_colour
+    with pytest.raises(ValueError, match="colour is 'red'"):
+        pftrack.Tracker(colour="red")
+
+
+def test_rows_keep_each_rows_histogram_across_blocks() -> None:
+    """The writer's store: rows before the first histogram, rows without one, and rows kept
+    without colours all read back as zeros; the others as given, across block boundaries."""
+    from pftrack.tracking.writer import _Rows
+
+    class Small(_Rows):
+        BLOCK = 4
+
+    rng = np.random.default_rng(3)
+    store, want = Small(), []
+    for n in range(11):
+        k = n % 3 + 1
+        rows = [[float(n + 1), float(j + 1), 0, 0, 1, 1, 1, -1, -1, -1] for j in range(k)]
+        if n < 2:
+            store.extend(rows, [None] * k)  # before any colour: zeros
+            want += [np.zeros(5)] * k
+            continue
+        cols: list[np.ndarray | None] = [rng.random(5) for _ in range(k)]
+        if n % 4 == 0:
+            cols[0] = None
+        if n == 7:
+            store.extend(rows, [None] * k)  # kept without colours: zeros
+            want += [np.zeros(5)] * k
+            continue
+        store.extend(rows, [None] * k, cols)
+        want += [np.zeros(5) if c is None else c for c in cols]
+    got = store.colours()
+    assert got is not None and np.array_equal(got, np.array(want))
+    assert len(got) == len(store) == len(store.arrays()[0])
+    assert _Rows().colours() is None

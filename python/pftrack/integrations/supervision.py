@@ -67,6 +67,7 @@ class TrackerOptions(TypedDict, total=False):
     smooth: bool
     link: bool
     crossings: bool
+    colour: str | None
     prime: RealLike | None
     max_side: int | None
     record: bool

@@ -592,6 +592,13 @@ class Tracker:
         With `smooth`, :meth:`finalize` also gives back the tails of two tracks the tracker
         swapped where they crossed (:class:`~pftrack.tracking.CrossingConfig`, motion and
         size only).
+    colour : {"swap", "link", "both"} or None
+        The offline pass's colour: the tracker keeps the histogram it holds for each row (the
+        matched detection's, or its filter's reference) and :meth:`finalize` hands them to
+        the fill's swap rule (``"swap"``, the default: a hole whose two sides each look more
+        like another object, an id handed to a neighbour, is left unfilled), the linker's
+        colour term (``"link"``) or both; None keeps none (880 bytes a row fewer with the
+        default 110 bins; docs/recovery.md, "The tracker's own colour in the offline pass").
     prime : float or None
         Seconds of frames :meth:`prime` reads (what ``pftrack track`` reads ahead). None
         (default): the command's 30 frames.
@@ -637,7 +644,9 @@ class Tracker:
 
     Memory grows with the run: every online row is kept until :meth:`finalize` (its offline
     pass needs the whole run), about 0.2 KB a row (measured with ``tracemalloc`` on a
-    synthetic scene: some 19 MB per person tracked for an hour at 25 frames/s). For an
+    synthetic scene: some 19 MB per person tracked for an hour at 25 frames/s), and with
+    `colour` (the default) its histogram, 0.88 KB more (110 float64; some 80 MB more per
+    person-hour; ``colour=None`` keeps none). For an
     unbounded stream, either track online only (``record=False``: nothing is kept, no
     offline pass), or read :meth:`settled_rows` from the last :attr:`n_settled` as you go and
     end a segment now and then with :meth:`finalize` and :meth:`reset`, which frees the rows
@@ -703,6 +712,7 @@ class Tracker:
         smooth: bool = True,
         link: bool = True,
         crossings: bool = CrossingConfig.enabled,
+        colour: str | None = "swap",
         prime: RealLike | None = None,
         max_side: int | None = TrackerConfig.max_side,
         record: bool = True,
@@ -833,6 +843,7 @@ class Tracker:
             link=link_config if link else None,
             prime_frames=PRIME_FRAMES if prime is None else _frames(prime, frame_rate, "prime"),
             record=record,
+            colour=colour,
         )
 
     @classmethod
@@ -847,7 +858,7 @@ class Tracker:
         smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
         link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
         prime_frames: IntLike = PRIME_FRAMES,
-        colour: str | None = None,
+        colour: str | None = "swap",
     ) -> Tracker:
         """A tracker from a full :class:`TrackerConfig` (frame-based), as ``pftrack track`` makes.
 
@@ -868,7 +879,10 @@ class Tracker:
             Frames :meth:`prime` reads.
         colour : {"swap", "link", "both"} or None
             The tracker's own histograms of its rows kept and handed to the offline pass
-            (:class:`TrackWriter`'s ``colour``); None (default): no colour there.
+            (:class:`TrackWriter`'s ``colour``): ``"swap"`` (default) to the fill's swap rule
+            (a hole whose sides each look more like another object is left), ``"link"`` to
+            the linker's colour term, ``"both"``; None: no colour kept (docs/recovery.md,
+            "The tracker's own colour in the offline pass").
         """
         self = cls.__new__(cls)
         self._setup(
@@ -887,7 +901,7 @@ class Tracker:
     def _setup(self, config: TrackerConfig, seed: RngLike, *, frame_rate: RealLike, fill: str,
                smoother: BoxSmoother | None, link: LinkConfig | None, prime_frames: IntLike,
                coasting: str = "confirmed", record: bool = True,
-               colour: str | None = None) -> None:  # fmt: skip
+               colour: str | None = "swap") -> None:  # fmt: skip
         if seed is not None and not isinstance(seed, (int, np.integer, np.random.Generator)):
             raise TypeError(f"seed must be an int, a Generator or None, got {type(seed).__name__}")
         if not isinstance(config, TrackerConfig):
@@ -985,6 +999,8 @@ class Tracker:
         with self._alone("reset"):
             self._tracker = MultiObjectTracker(self.config, rng=self.seed)
             self._writer = TrackWriter(*self._writer_args)
+            # the histograms of the rows kept for finalize's offline pass (none kept: none)
+            self._tracker.keep_colour = self.record and self._writer.colour is not None
             self.frame_count = 0
             #: The class (``cls`` of the detections; 0 without) of each id :meth:`finalize`
             #: returned.

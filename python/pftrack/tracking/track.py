@@ -136,8 +136,9 @@ class LiveTrack:
     #: this frame's was (:attr:`flat`). Class defaults: a checkpoint pickled before them has none.
     blind = 0
     flat = False
-    #: The last followed detection's histogram (:attr:`Track.colour`); a checkpoint pickled
-    #: before stop 74 has none.
+    #: The last followed detection's histogram (:attr:`Track.colour`), kept when the tracker
+    #: keeps colour (:attr:`~.tracker.MultiObjectTracker.keep_colour`); a checkpoint pickled
+    #: before stop 74 has none. The histograms of :attr:`unreported`'s boxes are ``unseen``.
     seen: F64 | None = None
 
     def __init__(self, track_id: int, box_xywh: F64, reference: F64, config: TrackerConfig,
@@ -174,9 +175,7 @@ class LiveTrack:
         self.cls = 0  # class id, set by the tracker at birth
         self.measured: F64 | None = box_xywh.copy()  # this frame's detection box
         self.unreported: list[tuple[int, F64, float]] = []
-        self.unseen: list[F64 | None] = []  # the histograms of `unreported`'s boxes
         self.reported = False
-        self.seen = reference  # the detection's histogram (a row the tracker does not change)
         # coasted frames with detections in a row whose colour likelihood was flat (a blind
         # coast: the centre filter's extrapolation alone), and whether this frame's was
         self.blind = 0
@@ -293,26 +292,32 @@ class LiveTrack:
         del trail[:k]
         return math.hypot(cx - x, cy - y) / (0.5 * (h + height)) / (frame_index - f)
 
-    def report(self, frame_index: int, early: bool, rules: LifecycleConfig) -> Track | None:
+    def report(
+        self, frame_index: int, early: bool, rules: LifecycleConfig, colour: bool = False
+    ) -> Track | None:
         """What to report for frame `frame_index` (None: nothing yet, or not any more).
 
         An unconfirmed track (outside the start-up frames, `early`) keeps its detection boxes
-        to hand over with its first report, as :attr:`Track.history`.
+        to hand over with its first report, as :attr:`Track.history`. With `colour`, the
+        report carries the histograms of its boxes (:attr:`Track.colour`); without it (the
+        default) nothing more is done than before they were kept.
         """
-        unseen = self.__dict__.get("unseen")  # a checkpoint from before stop 74 has none
         if self.hits < rules.min_hits and not early and not self.reported:
             if self.measured is not None:
                 self.unreported.append((frame_index, self.measured.copy(), float(self.score)))
-                if unseen is not None:
-                    unseen.append(self.seen)
+                if colour:
+                    self.__dict__.setdefault("unseen", []).append(self.seen)
             return None
         if self.time_since_update > 0 and self.rho < rules.coast_min_rho:
             return None
         history, self.unreported, self.reported = tuple(self.unreported), [], True
+        seen: F64 | None = None
         colours: tuple[F64 | None, ...] = ()
-        if history:
-            colours = tuple(unseen) if unseen else (None,) * len(history)
-        self.unseen = []
+        if colour:  # the matched detection's histogram, or the reference it coasts on
+            seen = self.filter.reference if self.measured is None else self.seen
+            if history:  # none kept: a checkpoint from before stop 74
+                unseen = self.__dict__.pop("unseen", None)
+                colours = tuple(unseen) if unseen else (None,) * len(history)
         return _new_track(
             self.id,
             self.box.copy(),
@@ -323,7 +328,7 @@ class LiveTrack:
             history,
             None if self.measured is None else self.measured.copy(),
             self.cls,
-            self.filter.reference if self.measured is None else self.seen,
+            seen,
             colours,
         )
 
@@ -451,8 +456,6 @@ def reseed_tracks(
     """
     if not tracks:
         return
-    for t, h in zip(tracks, hists, strict=True):  # the histogram each row was matched by
-        t.seen = h
     filters = [t.filter for t in tracks]
     reinitialise_filters(filters, _to_cxcywh(boxes_xywh), np.array([t.motion.v for t in tracks]))
     rate = config.reference_rate

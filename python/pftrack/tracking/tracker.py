@@ -159,6 +159,10 @@ class MultiObjectTracker:
     #: The built-in detector's objects kept (see ``__init__``): a class default for a
     #: checkpoint pickled before it was kept.
     kept_own = 0
+    #: Whether each report carries the histograms of its boxes (:attr:`.track.Track.colour`,
+    #: for an offline pass that uses them: :class:`~.writer.TrackWriter`'s ``colour``). Off,
+    #: nothing is stored (stop 74); a class default for checkpoints pickled before it.
+    keep_colour = False
 
     def __init__(self, config: TrackerConfig | None = None, rng: RngLike = None,
                  detector: FrameDetector | None = None) -> None:  # fmt: skip
@@ -866,7 +870,11 @@ class MultiObjectTracker:
         follow_pending()
         if followed:
             dis = [di for _, di in followed]
-            reseed_tracks([self.tracks[ti] for ti, _ in followed], boxes[dis], hists[dis], cfg)
+            chosen, seen = [self.tracks[ti] for ti, _ in followed], hists[dis]
+            reseed_tracks(chosen, boxes[dis], seen, cfg)
+            if self.keep_colour:  # the histogram each followed track was matched by
+                for t, h in zip(chosen, seen, strict=True):
+                    t.seen = h
         detected = len(boxes) > 0  # a frame without detections: not a miss (LiveTrack.coast)
         for ti in result.unmatched_tracks:
             self.tracks[ti].coast(detected)
@@ -913,12 +921,15 @@ class MultiObjectTracker:
             )
             t.det_index = int(index[di])
             t.cls = int(labels[di])
+            if self.keep_colour:
+                t.seen = hists[di]
             self.tracks.append(t)
             self._n_started += 1
 
         # 6. report
         early = self.frame_index <= cfg.lifecycle.min_hits
-        reports = (t.report(self.frame_index, early, cfg.lifecycle) for t in self.tracks)
+        keep = self.keep_colour
+        reports = (t.report(self.frame_index, early, cfg.lifecycle, keep) for t in self.tracks)
         return [r for r in reports if r is not None]
 
     def _beside(self, boxes: F64, labels: NDArray[np.int64], unmatched: Sequence[int],

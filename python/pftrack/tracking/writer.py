@@ -38,7 +38,9 @@ class _Rows:
         if self._col is not None:  # the full block's histograms, kept beside its rows
             assert self._cdone is not None
             self._cdone.append(self._col)
-            self._col = np.zeros_like(self._col)
+            # every row is written as it is kept (a row without one gets zeros): no memset of
+            # the block (11.6 k instructions an update of bench.test_api)
+            self._col = np.empty_like(self._col)
         self._rows = np.empty((self.BLOCK, 10))
         self._boxes = np.zeros((self.BLOCK, 4))
         self._has = np.zeros(self.BLOCK, bool)
@@ -63,7 +65,8 @@ class _Rows:
             first = next((c for c in colours if c is not None), None)
             if first is not None:  # the first histogram sets the bins; earlier rows had none
                 self._cdone = [np.zeros((self.BLOCK, len(first))) for _ in self._done]
-                self._col = np.zeros((self.BLOCK, len(first)))
+                self._col = np.empty((self.BLOCK, len(first)))  # rows written as kept
+                self._col[: self._n] = 0.0
         at = 0
         while at < len(rows):
             if self._n == self.BLOCK:
@@ -75,12 +78,27 @@ class _Rows:
                 if box is not None:
                     self._boxes[j] = box
                     self._has[j] = True
-            if colours is not None and self._col is not None:
-                for j, c in enumerate(colours[at : at + k], start=self._n):
-                    if c is not None:
-                        self._col[j] = c
+            if self._col is not None:
+                self._keep_colours(None if colours is None else colours[at : at + k], k)
             self._n += k
             at += k
+
+    def _keep_colours(self, colours: list[F64 | None] | None, k: int) -> None:
+        """Write the histograms of the next `k` rows (zeros for None) in one copy if it can."""
+        assert self._col is not None
+        at = slice(self._n, self._n + k)
+        if colours is None:
+            self._col[at] = 0.0
+            return
+        block = self._col[at]
+        try:
+            block[...] = colours  # one copy; a row without one (None) reads NaN
+            if block.sum() == block.sum():  # no NaN (a histogram is finite): the usual case
+                return
+        except (TypeError, ValueError):  # NumPy refused the mixed list: row by row below
+            pass
+        for j, c in enumerate(colours, start=self._n):
+            self._col[j] = 0.0 if c is None else c
 
     def __len__(self) -> int:
         return self.BLOCK * len(self._done) + self._n
@@ -196,12 +214,13 @@ class TrackWriter:
         colours: list[F64 | None] = []  # with `colour`: each row's histogram
         for t in tracks:
             self._cls[t.id] = t.cls
-            for f, box, score in t.history:  # a new track's detections from before confirmation
-                row = [float(f), float(t.id), *map(float, box), score, -1.0, -1.0, -1.0]
-                rows.append(row)
-                boxes.append(np.asarray(box))
-            if keep:
-                colours += t.history_colours or [None] * len(t.history)
+            if t.history:
+                for f, box, score in t.history:  # a new track's detections before confirmation
+                    row = [float(f), float(t.id), *map(float, box), score, -1.0, -1.0, -1.0]
+                    rows.append(row)
+                    boxes.append(np.asarray(box))
+                if keep:
+                    colours += t.history_colours or [None] * len(t.history)
             row = [float(frame), float(t.id), *t.box_xywh.tolist(), float(t.score)]
             row += [-1.0, -1.0, -1.0]
             if t.time_since_update == 0:
@@ -217,7 +236,8 @@ class TrackWriter:
                 boxes.append(t.detection_box)
                 self._last[t.id] = row
                 if keep:  # held-back rows: the reference each was reported with
-                    colours += self._held.pop(t.id, [None] * len(pending))
+                    if pending:
+                        colours += self._held.pop(t.id, [None] * len(pending))
                     colours.append(t.colour)
             elif self.coasting == "all":
                 rows.append(row)
