@@ -1,6 +1,6 @@
-"""The tracker's own colour in its offline pass (stop 74; the swap rule on by default).
+"""The tracker's own colour in its offline pass (stop 74; an option, off by default).
 
-A tracker made with ``colour`` (``"swap"`` by default) keeps, for each row it writes, the
+A tracker made with ``colour`` (e.g. ``"swap"``) keeps, for each row it writes, the
 histogram it already holds (the matched detection's, which the association compared, or the
 filter's reference while it coasts) and hands them to :func:`pftrack.tracking.smooth_tracks`
 as ``histograms``: the fill's swap rule (:func:`pftrack.recovery.fill.swap_holes`) and, with
@@ -221,14 +221,14 @@ def test_bad_histograms_and_options_are_refused_in_one_line() -> None:
         TrackWriter(colour=1)  # type: ignore[arg-type]
 
 
-def test_the_default_keeps_colour_for_the_swap_rule_and_an_online_tracker_none() -> None:
+def test_the_default_keeps_no_colour_and_an_online_tracker_none() -> None:
     tracker = pftrack.Tracker()
-    assert tracker._writer.colour == "swap" and tracker._tracker.keep_colour
-    assert pftrack.Tracker.from_config()._writer.colour == "swap"
-    online = pftrack.Tracker(record=False)
+    assert tracker._writer.colour is None and not tracker._tracker.keep_colour
+    assert pftrack.Tracker.from_config()._writer.colour is None
+    online = pftrack.Tracker(record=False, colour="swap")
     assert not online._tracker.keep_colour  # nothing kept, nothing stored
-    plain = pftrack.Tracker(colour=None)
-    assert plain._writer.colour is None and not plain._tracker.keep_colour
+    kept = pftrack.Tracker(colour="swap")
+    assert kept._writer.colour == "swap" and kept._tracker.keep_colour
     with pytest.raises(ValueError, match="colour is 'red'"):
         pftrack.Tracker(colour="red")
 

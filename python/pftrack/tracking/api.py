@@ -595,10 +595,11 @@ class Tracker:
     colour : {"swap", "link", "both"} or None
         The offline pass's colour: the tracker keeps the histogram it holds for each row (the
         matched detection's, or its filter's reference) and :meth:`finalize` hands them to
-        the fill's swap rule (``"swap"``, the default: a hole whose two sides each look more
-        like another object, an id handed to a neighbour, is left unfilled), the linker's
-        colour term (``"link"``) or both; None keeps none (880 bytes a row fewer with the
-        default 110 bins; docs/recovery.md, "The tracker's own colour in the offline pass").
+        the fill's swap rule (``"swap"``: a hole whose two sides each look more like another
+        object, an id handed to a neighbour, is left unfilled), the linker's colour term
+        (``"link"``) or both; None (default) keeps none. Kept, 880 bytes a row more with the
+        default 110 bins and 0.9 % more instructions an ``update`` (docs/recovery.md, "The
+        tracker's own colour in the offline pass").
     prime : float or None
         Seconds of frames :meth:`prime` reads (what ``pftrack track`` reads ahead). None
         (default): the command's 30 frames.
@@ -645,8 +646,7 @@ class Tracker:
     Memory grows with the run: every online row is kept until :meth:`finalize` (its offline
     pass needs the whole run), about 0.2 KB a row (measured with ``tracemalloc`` on a
     synthetic scene: some 19 MB per person tracked for an hour at 25 frames/s), and with
-    `colour` (the default) its histogram, 0.88 KB more (110 float64; some 80 MB more per
-    person-hour; ``colour=None`` keeps none). For an
+    `colour` its histogram, 0.88 KB more (110 float64; some 80 MB more per person-hour). For an
     unbounded stream, either track online only (``record=False``: nothing is kept, no
     offline pass), or read :meth:`settled_rows` from the last :attr:`n_settled` as you go and
     end a segment now and then with :meth:`finalize` and :meth:`reset`, which frees the rows
@@ -712,7 +712,7 @@ class Tracker:
         smooth: bool = True,
         link: bool = True,
         crossings: bool = CrossingConfig.enabled,
-        colour: str | None = "swap",
+        colour: str | None = None,
         prime: RealLike | None = None,
         max_side: int | None = TrackerConfig.max_side,
         record: bool = True,
@@ -858,7 +858,7 @@ class Tracker:
         smoother: BoxSmoother | None = BoxSmoother(),  # noqa: B008 - frozen, shared safely
         link: LinkConfig | None = LinkConfig(),  # noqa: B008 - frozen, shared safely
         prime_frames: IntLike = PRIME_FRAMES,
-        colour: str | None = "swap",
+        colour: str | None = None,
     ) -> Tracker:
         """A tracker from a full :class:`TrackerConfig` (frame-based), as ``pftrack track`` makes.
 
@@ -879,9 +879,9 @@ class Tracker:
             Frames :meth:`prime` reads.
         colour : {"swap", "link", "both"} or None
             The tracker's own histograms of its rows kept and handed to the offline pass
-            (:class:`TrackWriter`'s ``colour``): ``"swap"`` (default) to the fill's swap rule
-            (a hole whose sides each look more like another object is left), ``"link"`` to
-            the linker's colour term, ``"both"``; None: no colour kept (docs/recovery.md,
+            (:class:`TrackWriter`'s ``colour``): ``"swap"`` to the fill's swap rule (a hole
+            whose sides each look more like another object is left), ``"link"`` to the
+            linker's colour term, ``"both"``; None (default): no colour kept (docs/recovery.md,
             "The tracker's own colour in the offline pass").
         """
         self = cls.__new__(cls)
@@ -901,7 +901,7 @@ class Tracker:
     def _setup(self, config: TrackerConfig, seed: RngLike, *, frame_rate: RealLike, fill: str,
                smoother: BoxSmoother | None, link: LinkConfig | None, prime_frames: IntLike,
                coasting: str = "confirmed", record: bool = True,
-               colour: str | None = "swap") -> None:  # fmt: skip
+               colour: str | None = None) -> None:  # fmt: skip
         if seed is not None and not isinstance(seed, (int, np.integer, np.random.Generator)):
             raise TypeError(f"seed must be an int, a Generator or None, got {type(seed).__name__}")
         if not isinstance(config, TrackerConfig):

@@ -870,11 +870,10 @@ class MultiObjectTracker:
         follow_pending()
         if followed:
             dis = [di for _, di in followed]
-            chosen, seen = [self.tracks[ti] for ti, _ in followed], hists[dis]
-            reseed_tracks(chosen, boxes[dis], seen, cfg)
+            reseed_tracks([self.tracks[ti] for ti, _ in followed], boxes[dis], hists[dis], cfg)
             if self.keep_colour:  # the histogram each followed track was matched by
-                for t, h in zip(chosen, seen, strict=True):
-                    t.seen = h
+                for ti, di in followed:
+                    self.tracks[ti].seen = hists[di]
         detected = len(boxes) > 0  # a frame without detections: not a miss (LiveTrack.coast)
         for ti in result.unmatched_tracks:
             self.tracks[ti].coast(detected)

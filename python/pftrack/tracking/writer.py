@@ -90,13 +90,9 @@ class _Rows:
         if colours is None:
             self._col[at] = 0.0
             return
-        block = self._col[at]
-        try:
-            block[...] = colours  # one copy; a row without one (None) reads NaN
-            if block.sum() == block.sum():  # no NaN (a histogram is finite): the usual case
-                return
-        except (TypeError, ValueError):  # NumPy refused the mixed list: row by row below
-            pass
+        if not any(c is None for c in colours):  # every row has one (the usual case)
+            self._col[at] = colours  # one copy (None would be written as NaN)
+            return
         for j, c in enumerate(colours, start=self._n):
             self._col[j] = 0.0 if c is None else c
 
