@@ -618,35 +618,44 @@ inline constexpr PackTable kPackTable = make_pack_table();
 
 /// `BackgroundModel::global_gain`'s samples of one row, 4 a step, where the CPU has AVX2: the
 /// pixels x = 0, step, 2 step, ... of `px` (BGR bytes) and `q` (a background row's three float
-/// planes of `cols`), while a step's last pixel is at most cols - 2 (its 4-byte gather reads one
+/// planes of `cols`), while a step's last pixel is at most cols - 2 (its 4-byte load reads one
 /// byte past the pixel, inside the row). Per pixel the same integers and doubles as the scalar
 /// loop: si = B + G + R added to `levels`; sb = (double(q_b) + double(q_g)) + double(q_r); the
 /// ratio si / sb (one division of doubles) kept, in order, at `ratios` + `count` where
 /// !(sb < min_sum) and !(sb <= 0) (unordered compares: a NaN keeps or drops as the scalar
 /// test does). Writes 4 doubles at `ratios` + `count` a step (room for 3 beyond the kept ones).
-/// Returns the first x not done, which the scalar loop continues from. `step` * 9 fits in
-/// int32 (the gathers' offsets).
+/// Returns the first x not done, which the scalar loop continues from.
 __attribute__((target("avx2"))) inline Index gain_row_avx2(const std::uint8_t* px, const float* q,
                                                            Index cols, Index step, double min_sum,
                                                            double* ratios, std::size_t& count,
                                                            std::int64_t& levels) {
-    const auto s = static_cast<std::int32_t>(step);
-    const __m128i fi = _mm_setr_epi32(0, s, 2 * s, 3 * s);  // float offsets of the 4 pixels
-    const __m128i bi = _mm_setr_epi32(0, 3 * s, 6 * s, 9 * s);  // byte offsets
     const __m128i byte = _mm_set1_epi32(0xff);
     const __m256d ms = _mm256_set1_pd(min_sum), zero = _mm256_setzero_pd();
     __m256i lv = _mm256_setzero_si256();
     std::size_t n = count;
+    const Index s = step, s3 = 3 * step;
+    const auto bytes4 = [](const std::uint8_t* p) {  // B, G, R and the next byte
+        std::int32_t v;
+        std::memcpy(&v, p, 4);
+        return v;
+    };
     Index x = 0;
     for (; x + 3 * step <= cols - 2; x += 4 * step) {
-        const __m128i v = _mm_i32gather_epi32(reinterpret_cast<const int*>(px + 3 * x), bi, 1);
+        // scalar loads into lanes, not gathers: AMD's Zen cores microcode a gather (on this
+        // machine's EPYC a gather version counted fewer instructions and ran twice as long)
+        const std::uint8_t* b = px + 3 * x;
+        const __m128i v = _mm_setr_epi32(bytes4(b), bytes4(b + s3), bytes4(b + 2 * s3),
+                                         bytes4(b + 3 * s3));
         const __m128i si = _mm_add_epi32(
             _mm_add_epi32(_mm_and_si128(v, byte), _mm_and_si128(_mm_srli_epi32(v, 8), byte)),
             _mm_and_si128(_mm_srli_epi32(v, 16), byte));
         lv = _mm256_add_epi64(lv, _mm256_cvtepi32_epi64(si));
-        const __m256d b0 = _mm256_cvtps_pd(_mm_i32gather_ps(q + x, fi, 4));
-        const __m256d b1 = _mm256_cvtps_pd(_mm_i32gather_ps(q + cols + x, fi, 4));
-        const __m256d b2 = _mm256_cvtps_pd(_mm_i32gather_ps(q + 2 * cols + x, fi, 4));
+        const float* q0 = q + x;
+        const float* q1 = q0 + cols;
+        const float* q2 = q1 + cols;
+        const __m256d b0 = _mm256_cvtps_pd(_mm_setr_ps(q0[0], q0[s], q0[2 * s], q0[3 * s]));
+        const __m256d b1 = _mm256_cvtps_pd(_mm_setr_ps(q1[0], q1[s], q1[2 * s], q1[3 * s]));
+        const __m256d b2 = _mm256_cvtps_pd(_mm_setr_ps(q2[0], q2[s], q2[2 * s], q2[3 * s]));
         const __m256d sb = _mm256_add_pd(_mm256_add_pd(b0, b1), b2);
         const __m256d keep = _mm256_and_pd(_mm256_cmp_pd(sb, ms, _CMP_NLT_UQ),
                                            _mm256_cmp_pd(sb, zero, _CMP_NLE_UQ));
@@ -785,15 +794,15 @@ public:
         std::int64_t levels = 0;  // every sampled pixel's, as sampled_mean sums them
         bool avx2 = false;
 #ifdef PFTRACK_LUT_GATHER
-        avx2 = step <= (Index{1} << 26) && detail::avx2_usable();
+        avx2 = detail::avx2_usable();
 #endif
         for (Index y = 0; y < rows_; y += step) {
             const std::uint8_t* px = bgr + y * row_stride;
             const float* q = background_.data() + y * cols_ * 3;
             Index x = 0;
 #ifdef PFTRACK_LUT_GATHER
-            // 38 instructions a pixel below, about 12 there (the detector samples 2700 a
-            // PETS09 frame)
+            // 38 instructions a pixel in the loop below, 17 there (the detector samples 2700
+            // pixels of a PETS09 frame)
             if (avx2) x = detail::gain_row_avx2(px, q, cols_, step, min_sum, ratios, count, levels);
 #endif
             for (; x < cols_; x += step) {
