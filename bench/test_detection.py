@@ -1,6 +1,7 @@
 """Detection speed: the fused C++ pass (with and without HSV bins) vs OpenCV's MOG2 vs the
 NumPy reference, same frames;
-the blob pass and the size model's Theil-Sen line in C++ vs their Python references.
+the blob pass, the size model's Theil-Sen line and the light measures (`mean_and_gain`) in C++
+vs their Python references.
 
 pytest bench/test_detection.py --benchmark-only --benchmark-group-by=group
 """
@@ -216,6 +217,32 @@ def test_theil_sen_core(benchmark: BenchmarkFixture, size_samples: Any) -> None:
 def test_theil_sen_numpy(benchmark: BenchmarkFixture, size_samples: Any) -> None:
     benchmark.group = "Theil-Sen line, 200 samples"
     benchmark(theil_sen_reference, *size_samples)
+
+
+@pytest.mark.parametrize("path", ["avx2", "portable"])
+def test_mean_and_gain_core(benchmark: BenchmarkFixture, frames: Frames, path: str) -> None:
+    """The detector's every-frame light measures at its step (8 up to 640x480): the sampled
+    pixels 4 a step by AVX2 gathers (stop 74) or one by one (`_set_avx2(False)`)."""
+    name, fr = frames
+    benchmark.group = f"mean and gain at step 8 {name}"
+    m = _core.BackgroundModel()
+    m.apply(fr[0])
+    before = _core._set_avx2(path == "avx2")
+    try:
+        benchmark(cycle_apply(lambda f: m.mean_and_gain(f, 8), fr[1:]))
+    finally:
+        _core._set_avx2(before)
+
+
+def test_mean_and_gain_numpy(benchmark: BenchmarkFixture, frames: Frames) -> None:
+    from pftrack.detection.light import frame_gain
+
+    name, fr = frames
+    benchmark.group = f"mean and gain at step 8 {name}"
+    m = _core.BackgroundModel()
+    m.apply(fr[0])
+    bg = np.asarray(m.background)
+    benchmark(cycle_apply(lambda f: (f[::8, ::8].mean(), frame_gain(f, bg, 8)), fr[1:]))
 
 
 @pytest.fixture(scope="module")

@@ -513,9 +513,10 @@ void register_detection(py::module_& m) {
         [](bool allowed) { return detail::avx2_allowed().exchange(allowed); },
         py::arg("allowed"),
         "Testing hook: whether background.hpp's hand-written AVX2 passes may run (BackgroundModel."
-        "apply's row pass and difference histogram, hsv_bins' rows; morphology.hpp's packed masks: clean_mask, open_mask, "
-        "close_mask; where the CPU has AVX2; the portable loops otherwise, "
-        "the same results). Returns the previous setting; process-wide.");
+        "apply's row pass and difference histogram, hsv_bins' rows; morphology.hpp's packed "
+        "masks: clean_mask, open_mask, close_mask; mask_scan.hpp's 64-byte skip of a mask's "
+        "empty bytes: blob_boxes, masked hsv_bins; where the CPU has AVX2; the portable loops "
+        "otherwise, the same results). Returns the previous setting; process-wide.");
 
     m.def(
         "close_mask",

@@ -118,6 +118,31 @@ def test_lone_pixels_after_empty_stretches_of_every_length(cols: int) -> None:
     assert len(got) == cols + (2 if cols > 1 else 1)
 
 
+@pytest.mark.parametrize("allowed", [True, False], ids=["avx2", "portable"])
+@pytest.mark.parametrize("cols", [8, 33, 63, 64, 65, 127, 128, 129, 200, 480])
+def test_run_scan_skips_alike_with_and_without_avx2(cols: int, allowed: bool) -> None:
+    # the run scan's skip of empty bytes 64 a step with AVX2 (stop 74, det73's diff), then 32,
+    # 8 and one by one, or without it (`_set_avx2(False)`): a pixel after an empty stretch of
+    # every length 0 .. cols - 1 (every offset in a 64-byte step), a row with pixels at both
+    # ends, and sparse random masks, each against OpenCV's outer contours
+    rng = np.random.default_rng(cols)
+    lone = np.zeros((2 * cols + 2, cols), np.uint8)
+    for x in range(cols):
+        lone[2 * x, x] = 255
+    lone[2 * cols, 0] = lone[2 * cols, cols - 1] = 1
+    sparse = [(rng.random((40, cols)) < p).astype(np.uint8) * 255 for p in (0.002, 0.02, 0.2)]
+    before = _core._set_avx2(allowed)
+    try:
+        for mask in (lone, *sparse):
+            got, _ = _core.blob_boxes(mask, 0.0, 1.0, 1e-3, 1e3, 0.0, 0.0, None, *SIZE)
+            contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+            want = np.array([cv2.boundingRect(c) for c in contours], np.float64).reshape(-1, 4)
+            np.testing.assert_array_equal(got, want)
+    finally:
+        _core._set_avx2(before)
+    assert len(_core.blob_boxes(lone, 0.0, 1.0, 1e-3, 1e3, 0.0, 0.0, None, *SIZE)[0]) == cols + 2
+
+
 @pytest.mark.dataset
 def test_equals_reference_on_pets_masks() -> None:
     video = dataset("pets09-s2l1") / "video.avi"

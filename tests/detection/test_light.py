@@ -98,6 +98,57 @@ def test_mean_and_gain_are_sampled_mean_and_global_gain(step: int) -> None:
         _core.BackgroundModel().mean_and_gain(np.zeros((8, 8, 3), np.uint8))
 
 
+def gain_reference(
+    frame: np.ndarray, bg: np.ndarray, step: int, min_sum: float
+) -> tuple[float, float]:
+    """(sampled mean, global gain) as ``BackgroundModel.mean_and_gain`` defines them, bit for bit.
+
+    The background sum in double in the kernel's order ((B + G) + R), the ratios as one
+    division of doubles, kept where not (sum < min_sum) and not (sum <= 0) (a NaN `min_sum`
+    keeps every positive sum, as the C++ test does), and the median of the kept ones (the mean
+    of the two middle ones for an even count); 1 when none is kept.
+    """
+    f = frame[::step, ::step].astype(np.int64)
+    b = bg[::step, ::step].astype(np.float64)
+    si = (f[..., 0] + f[..., 1] + f[..., 2]).ravel()
+    sb = ((b[..., 0] + b[..., 1]) + b[..., 2]).ravel()
+    with np.errstate(invalid="ignore"):
+        keep = ~(sb < min_sum) & ~(sb <= 0.0)
+    r = np.sort(si[keep] / sb[keep])
+    mean = si.sum() / (3 * si.size)
+    if r.size == 0:
+        return mean, 1.0
+    k = r.size // 2
+    return mean, float(r[k] if r.size % 2 else 0.5 * (r[k - 1] + r[k]))
+
+
+@pytest.mark.parametrize("allowed", [True, False], ids=["avx2", "portable"])
+@pytest.mark.parametrize("step", [1, 2, 3, 4, 8])
+def test_gain_samples_alike_with_and_without_avx2(step: int, allowed: bool) -> None:
+    # the sampled pixels 4 a step by AVX2 gathers with a left-pack of the kept ratios (stop 74),
+    # or one by one (`_set_avx2(False)`, other CPUs): widths around every 4-pixel step and its
+    # tail (a step's last pixel at most cols - 2), dark pixels scattered so that every pattern
+    # of kept lanes occurs, background sums of exactly 0 (dropped even at min_sum 0), a NaN and
+    # an infinite min_sum, and a frame that is columns of a wider one (its row stride)
+    rng = np.random.default_rng(step)
+    before = _core._set_avx2(allowed)
+    try:
+        for cols in (1, 2, 3, 5, 8, 9, 12, 13, 14, 33, 64, 65, 130, 480):
+            bg = rng.uniform(0, 120, (23, cols, 3)).astype(np.float32)
+            bg[rng.random((23, cols)) < 0.3] = 2.0  # below min_sum 30
+            bg[rng.random((23, cols)) < 0.1] = 0.0
+            wide = rng.integers(0, 256, (23, cols + 7, 3), dtype=np.uint8)
+            for frame in (np.ascontiguousarray(wide[:, :cols]), wide[:, 3 : 3 + cols]):
+                m = _core.BackgroundModel()
+                m.set_background(bg)
+                for min_sum in (30.0, 0.0, float("nan"), float("inf")):
+                    want = gain_reference(frame, bg, step, min_sum)
+                    assert m.mean_and_gain(frame, step, min_sum) == want, (cols, min_sum)
+                    assert m.global_gain(frame, step, min_sum) == want[1]
+    finally:
+        _core._set_avx2(before)
+
+
 def test_frame_gain_of_uint8_frames_is_numpys_reduction_bit_for_bit() -> None:
     """The sums of uint8 channels are added as slices (exact integers): the same floats."""
     from pftrack.detection.light import _pixel_sums

@@ -28,27 +28,6 @@
 
 namespace pftrack {
 
-namespace detail {
-
-/// Whether this file's hand-written AVX2 passes may run where the CPU has AVX2
-/// (`background_row_fused_avx2`, `histogram_row_avx2`, `HsvLut::bins_of_row`, and so
-/// `hsv_bins_image`'s): true unless a test turns it off (`pftrack._core._set_avx2`) to hold the
-/// portable loops, which other CPUs run, to the same reference on the same machine.
-inline std::atomic<bool>& avx2_allowed() {
-    static std::atomic<bool> allowed{true};
-    return allowed;
-}
-
-#ifdef PFTRACK_LUT_GATHER
-/// Whether an AVX2 pass (this file's, camera.hpp's `grey_halved`) runs now: the CPU has AVX2
-/// and no test turned the passes off (`avx2_allowed`).
-inline bool avx2_usable() {
-    return __builtin_cpu_supports("avx2") && avx2_allowed().load(std::memory_order_relaxed);
-}
-#endif
-
-}  // namespace detail
-
 /// `hsv_bin_of` as table look-ups, without branches: identical results (tests check all 2^24
 /// colours), several times faster. The colour/grey decision and the saturation bin depend on
 /// (max, min) only, the value bin on max only, the hue bin on (sector, numerator, max - min) only.
@@ -617,6 +596,83 @@ __attribute__((target("avx2"))) inline Index histogram_row_avx2(
     }
     return x;
 }
+
+/// For each 4-bit mask k of kept lanes, the 32-bit lane indices that move the kept doubles of a
+/// 4-double vector to its front, in order (`gain_row_avx2`'s left-pack); the rest are 0.
+struct PackTable {
+    std::int32_t lanes[16][8];
+};
+constexpr PackTable make_pack_table() {
+    PackTable t{};
+    for (int k = 0; k < 16; ++k) {
+        int o = 0;
+        for (int i = 0; i < 4; ++i)
+            if (k & (1 << i)) {
+                t.lanes[k][o++] = 2 * i;
+                t.lanes[k][o++] = 2 * i + 1;
+            }
+    }
+    return t;
+}
+inline constexpr PackTable kPackTable = make_pack_table();
+
+/// `BackgroundModel::global_gain`'s samples of one row, 4 a step, where the CPU has AVX2: the
+/// pixels x = 0, step, 2 step, ... of `px` (BGR bytes) and `q` (a background row's three float
+/// planes of `cols`), while a step's last pixel is at most cols - 2 (its 4-byte load reads one
+/// byte past the pixel, inside the row). Per pixel the same integers and doubles as the scalar
+/// loop: si = B + G + R added to `levels`; sb = (double(q_b) + double(q_g)) + double(q_r); the
+/// ratio si / sb (one division of doubles) kept, in order, at `ratios` + `count` where
+/// !(sb < min_sum) and !(sb <= 0) (unordered compares: a NaN keeps or drops as the scalar
+/// test does). Writes 4 doubles at `ratios` + `count` a step (room for 3 beyond the kept ones).
+/// Returns the first x not done, which the scalar loop continues from.
+__attribute__((target("avx2"))) inline Index gain_row_avx2(const std::uint8_t* px, const float* q,
+                                                           Index cols, Index step, double min_sum,
+                                                           double* ratios, std::size_t& count,
+                                                           std::int64_t& levels) {
+    const __m128i byte = _mm_set1_epi32(0xff);
+    const __m256d ms = _mm256_set1_pd(min_sum), zero = _mm256_setzero_pd();
+    __m256i lv = _mm256_setzero_si256();
+    std::size_t n = count;
+    const Index s = step, s3 = 3 * step;
+    const auto bytes4 = [](const std::uint8_t* p) {  // B, G, R and the next byte
+        std::int32_t v;
+        std::memcpy(&v, p, 4);
+        return v;
+    };
+    Index x = 0;
+    for (; x + 3 * step <= cols - 2; x += 4 * step) {
+        // scalar loads into lanes, not gathers: AMD's Zen cores microcode a gather (on this
+        // machine's EPYC a gather version counted fewer instructions and ran twice as long)
+        const std::uint8_t* b = px + 3 * x;
+        const __m128i v = _mm_setr_epi32(bytes4(b), bytes4(b + s3), bytes4(b + 2 * s3),
+                                         bytes4(b + 3 * s3));
+        const __m128i si = _mm_add_epi32(
+            _mm_add_epi32(_mm_and_si128(v, byte), _mm_and_si128(_mm_srli_epi32(v, 8), byte)),
+            _mm_and_si128(_mm_srli_epi32(v, 16), byte));
+        lv = _mm256_add_epi64(lv, _mm256_cvtepi32_epi64(si));
+        const float* q0 = q + x;
+        const float* q1 = q0 + cols;
+        const float* q2 = q1 + cols;
+        const __m256d b0 = _mm256_cvtps_pd(_mm_setr_ps(q0[0], q0[s], q0[2 * s], q0[3 * s]));
+        const __m256d b1 = _mm256_cvtps_pd(_mm_setr_ps(q1[0], q1[s], q1[2 * s], q1[3 * s]));
+        const __m256d b2 = _mm256_cvtps_pd(_mm_setr_ps(q2[0], q2[s], q2[2 * s], q2[3 * s]));
+        const __m256d sb = _mm256_add_pd(_mm256_add_pd(b0, b1), b2);
+        const __m256d keep = _mm256_and_pd(_mm256_cmp_pd(sb, ms, _CMP_NLT_UQ),
+                                           _mm256_cmp_pd(sb, zero, _CMP_NLE_UQ));
+        const int k = _mm256_movemask_pd(keep);
+        const __m256d r = _mm256_div_pd(_mm256_cvtepi32_pd(si), sb);  // dropped lanes unused
+        const __m256i order =
+            _mm256_loadu_si256(reinterpret_cast<const __m256i*>(kPackTable.lanes[k]));
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(ratios + n),
+                            _mm256_permutevar8x32_epi32(_mm256_castpd_si256(r), order));
+        n += static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(k)));
+    }
+    alignas(32) std::int64_t l[4];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(l), lv);
+    levels += (l[0] + l[1]) + (l[2] + l[3]);
+    count = n;
+    return x;
+}
 #endif
 
 }  // namespace detail
@@ -728,12 +784,28 @@ public:
                        double* mean = nullptr) {
         require(initialized(), "BackgroundModel.global_gain", "the model has no background yet");
         require(step >= 1, "BackgroundModel.global_gain", "step", static_cast<double>(step), ">= 1");
-        ratios_.clear();
+        const Index per_row = (cols_ - 1) / step + 1;
+        // room for every sample and the 3 doubles past the kept ones that gain_row_avx2 writes;
+        // grown, never shrunk (a resize that shrank and grew again would zero-fill each frame)
+        const auto room = static_cast<size_t>(((rows_ - 1) / step + 1) * per_row + 4);
+        if (ratios_.size() < room) ratios_.resize(room);
+        double* ratios = ratios_.data();
+        size_t count = 0;
         std::int64_t levels = 0;  // every sampled pixel's, as sampled_mean sums them
+        bool avx2 = false;
+#ifdef PFTRACK_LUT_GATHER
+        avx2 = detail::avx2_usable();
+#endif
         for (Index y = 0; y < rows_; y += step) {
             const std::uint8_t* px = bgr + y * row_stride;
             const float* q = background_.data() + y * cols_ * 3;
-            for (Index x = 0; x < cols_; x += step) {
+            Index x = 0;
+#ifdef PFTRACK_LUT_GATHER
+            // 38 instructions a pixel in the loop below, 17 there (the detector samples 2700
+            // pixels of a PETS09 frame)
+            if (avx2) x = detail::gain_row_avx2(px, q, cols_, step, min_sum, ratios, count, levels);
+#endif
+            for (; x < cols_; x += step) {
                 // the sum of three bytes, exact in int and in double: the same ratio as the sum
                 // taken in double
                 const int si = px[3 * x] + px[3 * x + 1] + px[3 * x + 2];
@@ -741,22 +813,20 @@ public:
                 const double sb = static_cast<double>(q[x]) + static_cast<double>(q[cols_ + x]) +
                                   static_cast<double>(q[2 * cols_ + x]);
                 if (sb < min_sum || sb <= 0.0) continue;
-                ratios_.push_back(static_cast<double>(si) / sb);
+                ratios[count++] = static_cast<double>(si) / sb;
             }
         }
         if (mean != nullptr) {
             const Index n = ((rows_ - 1) / step + 1) * ((cols_ - 1) / step + 1) * 3;
             *mean = static_cast<double>(levels) / static_cast<double>(n);
         }
-        const size_t n = ratios_.size();
+        const size_t n = count;
         if (n == 0) return 1.0;
         const size_t k = n / 2;
-        std::nth_element(ratios_.begin(), ratios_.begin() + static_cast<std::ptrdiff_t>(k),
-                         ratios_.end());
-        const double hi = ratios_[k];
+        std::nth_element(ratios, ratios + k, ratios + n);
+        const double hi = ratios[k];
         if (n % 2 == 1) return hi;
-        const double lo = *std::max_element(ratios_.begin(),
-                                            ratios_.begin() + static_cast<std::ptrdiff_t>(k));
+        const double lo = *std::max_element(ratios, ratios + k);
         return 0.5 * (lo + hi);
     }
 
@@ -1189,6 +1259,7 @@ inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index row
                            Index row_stride, const std::uint8_t* mask, Index mask_stride,
                            std::int16_t* out, Index out_stride) {
     std::vector<std::int32_t> si, hi;  // the table indices of a row, without AVX2
+    const bool avx2 = mask != nullptr && detail::avx2_usable();
     for (Index y = 0; y < rows; ++y) {
         std::int16_t* o = out + y * out_stride;
         const std::uint8_t* px = bgr + y * row_stride;
@@ -1206,7 +1277,7 @@ inline void hsv_bins_image(const HsvLut& lut, const std::uint8_t* bgr, Index row
         std::fill(o, o + cols, std::int16_t(-1));
         Index x = 0;
         while (x < cols) {
-            x = detail::skip_zero_words(m, x, cols);  // most rows are background
+            x = detail::skip_zero_words(m, x, cols, avx2);  // most rows are background
             if (x + 8 <= cols) {
                 std::uint64_t word;
                 // a run of 8-pixel groups that each hold a masked pixel (a blob's row): binned

@@ -333,6 +333,7 @@ inline std::vector<BlobRect> outer_regions(const std::uint8_t* mask, Index rows,
     std::vector<Index> left_bg;  // per foreground run: the background run just left, or -1
     fg.row_start.assign(static_cast<std::size_t>(rows + 1), 0);
     bg.row_start.assign(static_cast<std::size_t>(rows + 1), 0);
+    const bool avx2 = detail::avx2_usable();
     for (Index y = 0; y < rows; ++y) {
         fg.row_start[static_cast<std::size_t>(y)] = static_cast<Index>(fg.a.size());
         bg.row_start[static_cast<std::size_t>(y)] = static_cast<Index>(bg.a.size());
@@ -340,7 +341,7 @@ inline std::vector<BlobRect> outer_regions(const std::uint8_t* mask, Index rows,
         Index x = 0;
         while (x < cols) {
             const Index s = x;
-            x = detail::skip_zero_words(p, x, cols);  // background is most of a mask
+            x = detail::skip_zero_words(p, x, cols, avx2);  // background is most of a mask
             while (x < cols && p[x] == 0) ++x;
             if (x > s) {
                 bg.a.push_back(s);
