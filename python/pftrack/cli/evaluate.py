@@ -292,6 +292,7 @@ def run(args: argparse.Namespace) -> int:
         check_scale,
         evaluate_sequence,
         format_scores,
+        name_seqinfo,
         scores_csv,
         scores_doc,
     )
@@ -366,7 +367,7 @@ def run(args: argparse.Namespace) -> int:
                         on_progress=_mover(bar, sum(frames[:k]), frames[k]),
                     )
             except ValueError as exc:
-                message = _in_file(str(exc), seq.gt_path, path)
+                message = _in_file(name_seqinfo(str(exc), seq.seqinfo), seq.gt_path, path)
                 if folder and "MOT15-style" in message:  # say where MOT17 rules came from
                     message += f" (--benchmark auto took {folder[0]} from its folder {folder[1]})"
                 raise ValueError(message) from None
