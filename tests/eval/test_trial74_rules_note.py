@@ -59,12 +59,11 @@ def test_the_note_counts_what_numpy_counts() -> None:
     assert (m.num_objects, m.false_positives, m.misses) == (scored, FRAMES, 0)
     assert (m.num_ignored_gt, m.num_ignored_predictions) == (len(gt) - scored, 2 * FRAMES)
     # MOT15 rules: no classes, the flag alone
-    note15 = gt_rules_note(gt, result, "MOT15")
-    assert note15 is not None and note15.startswith(
+    assert gt_rules_note(gt, result, "MOT15") == (
         f"MOT15 rules, as TrackEval: {len(gt) - FRAMES} of its {len(gt)} rows scored (flagged 1 "
         f"in column 7); not scored: {FRAMES} rows flagged 0 (column 7); result boxes on them "
         "count as false positives"
-    )
+    )  # no word of visibility: MOT15's columns 8-10 are world coordinates
     # every row scored: nothing to say
     every = gt[gt[:, 7] == 1][gt[gt[:, 7] == 1][:, 6] == 1]
     assert gt_rules_note(every, result, "MOT17") is None
@@ -101,3 +100,22 @@ def test_a_truth_scored_whole_says_nothing(
     res = write(tmp_path / "res.txt", rows[:, :6])
     assert main(["eval", "--gt", str(gt), "--res", str(res)]) == 0
     assert "rules, as TrackEval" not in capsys.readouterr().out
+
+
+@pytest.mark.dataset
+def test_the_datas_truths_said_as_numpy_counts_them() -> None:
+    """PETS09-S2L1's MOT15 truth flags some rows 0; TUD-Campus's flags none."""
+    from pftrack.eval.rows import gt_rules_note
+    from pftrack.io.mot import read_mot
+    from tests.conftest import dataset
+
+    pets = read_mot(dataset("pets09-s2l1") / "gt.txt")
+    flagged = int(np.sum(pets[:, 6] == 0))
+    assert flagged > 0
+    assert gt_rules_note(pets, pets, "MOT15") == (
+        f"MOT15 rules, as TrackEval: {len(pets) - flagged} of its {len(pets)} rows scored "
+        f"(flagged 1 in column 7); not scored: {flagged} rows flagged 0 (column 7); result "
+        "boxes on them count as false positives"
+    )
+    tud = read_mot(dataset("tud-campus") / "gt.txt")
+    assert gt_rules_note(tud, tud, "MOT15") is None

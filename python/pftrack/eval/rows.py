@@ -299,8 +299,8 @@ def gt_rules_note(
     TrackEval counts them), without a word of either. The note counts the ground-truth rows
     not scored, by class (MOT16/17/20) and by the consider flag (column 7), the result boxes
     left out (matched to a distractor), says that boxes on the other rows not scored count
-    as false positives, and that visibility (column 9) is not thresholded. None when every
-    ground-truth row is scored.
+    as false positives, and that visibility (column 9) is not thresholded (MOT16/17/20: MOT15's
+    columns 8-10 are world coordinates). None when every ground-truth row is scored.
 
     Parameters
     ----------
@@ -344,9 +344,8 @@ def gt_rules_note(
             f"{', '.join(map(str, distractors))}) left out, boxes on the other rows not "
             "scored count as false positives"
         )
-    else:
-        said += "; result boxes on them count as false positives"
-    return said + "; visibility (column 9) is not thresholded"
+        return said + "; visibility (column 9) is not thresholded"
+    return said + "; result boxes on them count as false positives"  # MOT15: no visibility
 
 
 def gt_conf_note(gt: ArrayLike) -> str | None:
