@@ -93,7 +93,7 @@ def test_motfile_is_a_path_with_its_numbering() -> None:
         MotFile("a", True)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="^MotFile: path must be a str or os.PathLike"):
         MotFile(None)  # type: ignore[arg-type]
-    with pytest.raises(ValueError, match="^first_frame is -1"):
+    with pytest.raises(ValueError, match="^read_mot: first_frame is -1"):
         read_mot("x.txt", first_frame=-1)
 
 

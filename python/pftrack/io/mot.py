@@ -305,7 +305,11 @@ def read_mot(
         With `warn_extra`, once, naming the file and its most columns on a line, when that is
         more than 10: columns 11 and beyond are not kept.
     """
-    base = stated_base(path) if first_frame is None else frame_base(first_frame, "first_frame")
+    base = (
+        stated_base(path)
+        if first_frame is None
+        else frame_base(first_frame, "read_mot: first_frame")
+    )
     p = Path(path_arg(path, "read_mot: path"))
     _check.text(what, "read_mot: what", none=False)  # it names the file in every message below
     if not p.is_file():
