@@ -848,7 +848,10 @@ def test_a_truth_beyond_seqlength_is_refused_as_pftrack_eval_refuses_it(
     out = tmp_path / "out"
     assert main(["batch", str(seq), "--out", str(out), "--workers", "0", *FAST]) == 1
     (entry,) = json.loads((out / "summary.json").read_text())["sequences"]
-    said = "ground truth has frame 31, beyond the sequence's 30 frames (seqLength)"
+    said = (  # the seqinfo.ini named (stop 74)
+        "ground truth has frame 31, beyond the sequence's 30 frames (seqLength in "
+        f"{seq / 'seqinfo.ini'})"
+    )
     assert entry["status"] == "failed" and entry["metrics"] is None, entry
     assert (
         entry["error"]

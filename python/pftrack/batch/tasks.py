@@ -33,6 +33,7 @@ from pftrack._warn import warn
 from pftrack.batch.inputs import SequenceInput
 
 if TYPE_CHECKING:  # importing pftrack.tracking loads the whole tracker; recover needs none of it
+    from pftrack.io.mot import MotFile
     from pftrack.tracking.config import TrackerConfig
 
 __all__ = [
@@ -187,6 +188,8 @@ def _settings(options: object) -> dict[str, Any]:
 
     text = json.dumps(dataclasses.asdict(options), sort_keys=True, default=str)  # type: ignore[call-overload]
     value: dict[str, Any] = json.loads(text)
+    if value.get("det_base", 0) is None:  # not stated: the settings of the runs before it
+        del value["det_base"]  # (was not a field): their outputs stay complete
     return value
 
 
@@ -234,6 +237,11 @@ class TrackOptions:
         when the sequence has one (0.625 for PETS09-S2L1's video), else 1. The ground truth
         is scaled by ``seqinfo.ini``'s size where it gives one, else, with ``detections``
         "auto", by this (a sequence's detections and ground truth share their pixels).
+    det_base : {None, 0, 1}
+        The number the detection files' frames count from (``--det-base``): 1 is
+        MOTChallenge's; 0 reads a file numbered from 0 (a row on frame 0 is frame 1). None
+        reads from 1 and warns of a file that looks numbered from 0
+        (:func:`pftrack.io.mot.zero_based_note`); 0 and 1 say nothing of it.
     fill : {"linear", "pf"}
         As ``pftrack track --fill``.
     smooth, link : bool
@@ -255,6 +263,7 @@ class TrackOptions:
     seed: int = 0
     detections: str | None = None
     det_scale: float | None = None
+    det_base: int | None = None
     fill: FillMode = "linear"
     smooth: bool = True
     link: bool = True
@@ -278,6 +287,15 @@ class TrackOptions:
                 raise ValueError(
                     f"{own}: det_scale is {self.det_scale}, expected a number in "
                     f"[{lo:g}, {hi:g}] (or None: from seqinfo.ini)"
+                )
+        if self.det_base is not None:
+            from pftrack.io.mot import frame_base
+
+            frame_base(self.det_base, f"{own}: det_base")
+            if self.detections is None:  # the built-in detector reads no file
+                raise ValueError(
+                    f"{own}: det_base is {self.det_base}, but detections is None (the built-in "
+                    "detector): give detections='auto', or leave det_base None"
                 )
         _check_choice(self.fill, f"{own}: fill", ("linear", "pf"))
         flag(self.smooth, f"{own}: smooth")
@@ -362,7 +380,7 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
         :func:`~pftrack.io.mot.write_mot`), the annotated video if asked for, and the figures;
         its `error` is set if the ground truth could not be scored (the rows are still there).
     """
-    from pftrack.io.mot import as_written, read_ground_truth
+    from pftrack.io.mot import MotFile, as_written, read_ground_truth
     from pftrack.io.video import FrameSource, info_scale, read_seqinfo
     from pftrack.recovery.linking import check_scored_ids
     from pftrack.tracking.run import SeqinfoScale, track_path
@@ -379,7 +397,9 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
     auto_scale = info_scale(
         (frames.width, frames.height), (seq.image_width, seq.image_height), seq.name
     )
-    det = seq.detections if options.detections == "auto" else None
+    det: Path | MotFile | None = seq.detections if options.detections == "auto" else None
+    if det is not None and options.det_base is not None:  # read as numbered so, said nothing
+        det = MotFile(det, options.det_base)
     det_scale = options.det_scale if options.det_scale is not None else SeqinfoScale(auto_scale)
     # the ground truth's pixels: seqinfo.ini's size when it gives one, else those of the given
     # detections' scale (det.txt and gt.txt of one sequence share them; was: 1, and MOTA -100
@@ -456,7 +476,11 @@ def track_sequence(seq: SequenceInput, options: TrackOptions) -> TaskResult:
                 num_frames=None if seq.seqinfo is None else read_seqinfo(seq.seqinfo).length,
             )
         except Exception as exc:  # noqa: BLE001 - the tracks are written, the task is failed
-            scoring = f"scoring against {seq.gt} (the tracks are written): {one_line(exc)}"
+            # imported here: the refusal may come before the scorers' import above
+            from pftrack.eval.sequences import name_seqinfo
+
+            said = name_seqinfo(one_line(exc), seq.seqinfo)  # a seqLength refusal: which ini
+            scoring = f"scoring against {seq.gt} (the tracks are written): {said}"
             error = scoring if error is None else f"{error}; {scoring}"
             trace = traceback.format_exc()
     info: dict[str, Any] = {

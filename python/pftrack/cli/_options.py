@@ -251,6 +251,19 @@ def max_side(text: str) -> int:
 max_side.__name__ = "int"
 
 
+#: The numbers a detection file's frames may count from (``--det-base``):
+#: :data:`pftrack.io.mot.FRAME_BASES`, stated here so that ``--help`` imports no reader (a
+#: test checks they agree).
+DET_BASES = (0, 1)
+#: ``--det-base``'s help, the same for ``pftrack track`` and ``pftrack batch``.
+DET_BASE_HELP = (
+    "the number the detection file's frames count from (default: 1, MOTChallenge's, with a "
+    "warning for a file that looks numbered from 0 and is not refused); 0: numbered from 0 (a "
+    "decoder's index, KITTI's, Python's enumerate), read with 1 added to every frame; 1 "
+    "stated: read from 1 without that warning"
+)
+
+
 def det_scale(text: str) -> float | None:
     """Argument type of ``--det-scale``: ``auto`` (None) or a number in :data:`DET_SCALE_RANGE`."""
     return None if text == "auto" else float(bounded_float(*DET_SCALE_RANGE)(text))
@@ -520,6 +533,11 @@ def tracker_config(args: argparse.Namespace) -> TrackerConfig:
             raise ValueError(
                 f"--det-scale {args.det_scale:g} scales the boxes of --detections; the built-in "
                 "detector's are in the frame's pixels: drop it, or give --detections"
+            )
+        if getattr(args, "det_base", None) is not None:
+            raise ValueError(
+                f"--det-base {args.det_base} says how --detections numbers its frames; the "
+                "built-in detector reads no file: drop it, or give --detections"
             )
         if args.birth_score is not None:
             raise ValueError(

@@ -15,6 +15,8 @@ from typing import TYPE_CHECKING, Any
 
 from pftrack._threads import usable_cpus
 from pftrack.cli._options import (
+    DET_BASE_HELP,
+    DET_BASES,
     DET_SCALE_RANGE,
     IOU_HELP,
     add_command,
@@ -191,6 +193,10 @@ def add_parser(sub: Any) -> None:
         "auto: the frame width over seqinfo.ini's imWidth where there is one (0.625 for "
         "PETS09-S2L1's video), else 1; a number only with --detections auto",
     )  # fmt: skip
+    p.add_argument(
+        "--det-base", type=int, choices=DET_BASES, default=None, metavar="{0,1}",
+        help=f"{DET_BASE_HELP}; only with --detections auto",
+    )  # fmt: skip
     p.add_argument("--render", action="store_true",
                    help="also write DIR/NAME.mp4: the final tracks of DIR/NAME.txt (linked, "
                    "filled and smoothed) drawn on the frames, boxes, ids and trails, as "
@@ -352,6 +358,7 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         detections=args.detections,
         det_scale=args.det_scale,
+        det_base=args.det_base,
         fill=args.fill,
         smooth=not args.no_smooth,
         link=not args.no_link,

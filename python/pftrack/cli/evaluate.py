@@ -284,7 +284,12 @@ def run(args: argparse.Namespace) -> int:
 
     from pftrack._progress import Bar, enabled
     from pftrack.cli._signals import hold_interrupts
-    from pftrack.eval.rows import frame_ranges_notes, gt_conf_note, result_class_note
+    from pftrack.eval.rows import (
+        frame_ranges_notes,
+        gt_conf_note,
+        gt_rules_note,
+        result_class_note,
+    )
     from pftrack.eval.sequences import (
         NONE_MATCHED,
         SequenceScores,
@@ -292,6 +297,7 @@ def run(args: argparse.Namespace) -> int:
         check_scale,
         evaluate_sequence,
         format_scores,
+        name_seqinfo,
         scores_csv,
         scores_doc,
     )
@@ -340,6 +346,7 @@ def run(args: argparse.Namespace) -> int:
 
     scores: dict[str, SequenceScores] = {}
     notes: list[str] = []
+    said: list[str] = []  # gt_rules_note's: below the table's legend
     # the bar counts the frames scored (those of the ground truth or the result), moved as
     # each sequence is scored: it counted sequences, and one long sequence sat at 0/1
     with Bar(sum(frames), desc=_bar_label(0, len(loaded)), enable=shown, unit="frame") as bar:
@@ -366,7 +373,7 @@ def run(args: argparse.Namespace) -> int:
                         on_progress=_mover(bar, sum(frames[:k]), frames[k]),
                     )
             except ValueError as exc:
-                message = _in_file(str(exc), seq.gt_path, path)
+                message = _in_file(name_seqinfo(str(exc), seq.seqinfo), seq.gt_path, path)
                 if folder and "MOT15-style" in message:  # say where MOT17 rules came from
                     message += f" (--benchmark auto took {folder[0]} from its folder {folder[1]})"
                 raise ValueError(message) from None
@@ -380,6 +387,9 @@ def run(args: argparse.Namespace) -> int:
             if note:
                 notes.append(f"{path}: {note}")
             note = gt_conf_note(gt)
+            if not note:  # which rows the rules scored (was: "MOT17 ground-truth rules" alone)
+                rules = gt_rules_note(gt, res, scores[name].benchmark, scale=s)
+                said.extend([f"{seq.gt_path}: {rules}"] if rules else [])
             if note:
                 notes.append(f"{seq.gt_path}: {note}")
             elif not scores[name].mot.num_matches and scores[name].mot.num_objects:
@@ -410,5 +420,8 @@ def run(args: argparse.Namespace) -> int:
     for note in notes:  # once the files are written, as pftrack render says its warnings
         print(f"pftrack eval: warning: {note}", file=sys.stderr)
     # after the files: a closed stdout cannot lose them; not into a file written to stdout
-    print(format_scores(scores, combined), file=report_stream(args.json, args.csv))
+    report = report_stream(args.json, args.csv)
+    print(format_scores(scores, combined), file=report)
+    for line in said:  # below the legend: which rows its rules scored (a fact, no warning)
+        print(line, file=report)
     return 0

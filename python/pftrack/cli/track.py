@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import os
 import signal
 import sys
 import warnings
@@ -12,6 +13,8 @@ from typing import IO, Any
 
 from pftrack._warn import warn
 from pftrack.cli._options import (
+    DET_BASE_HELP,
+    DET_BASES,
     DET_SCALE_RANGE,
     FPS_RANGE,
     TRACKS_YOURS,
@@ -79,6 +82,10 @@ def add_parser(sub: Any) -> None:
         f"({DET_SCALE_RANGE[0]:g} to {DET_SCALE_RANGE[1]:g}; 0.625 for PETS09 det.txt on its "
         "480x360 video); auto: for the sequence's own detections, the frame width over "
         "seqinfo.ini's imWidth, else 1; a number only with --detections",
+    )  # fmt: skip
+    p.add_argument(
+        "--det-base", type=int, choices=DET_BASES, default=None, metavar="{0,1}",
+        help=f"{DET_BASE_HELP}; only with --detections",
     )  # fmt: skip
     p.add_argument(
         "--fps", type=bounded_float(*FPS_RANGE), metavar="FPS",
@@ -200,19 +207,33 @@ def _abort_note(out: str, side: Any, streamed: int | None, committed: bool) -> s
     return None
 
 
-def _resolve_detections(args: argparse.Namespace, source: Any) -> str | None:
+def _resolve_detections(args: argparse.Namespace, source: Any) -> str | os.PathLike[str] | None:
+    """The detection file's path; with ``--det-base``, a :class:`~pftrack.io.mot.MotFile`.
+
+    The numbering travels with the path: ``load_detections`` reads it so, and the note of a
+    file that looks numbered from 0 is not said of a numbering the user stated.
+    """
     if args.detections != "auto":
-        return str(args.detections) if args.detections else None
-    found = source.sequence.detections if source.sequence is not None else None
-    if found is None:
-        raise ValueError(
-            f"--detections auto: {args.source} is not a MOTChallenge sequence with det/det.txt "
-            "(a folder with seqinfo.ini or img1/, or its img1/); give the detection file"
-        )
-    return str(found)
+        path = str(args.detections) if args.detections else None
+    else:
+        found = source.sequence.detections if source.sequence is not None else None
+        if found is None:
+            raise ValueError(
+                f"--detections auto: {args.source} is not a MOTChallenge sequence with "
+                "det/det.txt (a folder with seqinfo.ini or img1/, or its img1/); give the "
+                "detection file"
+            )
+        path = str(found)
+    if path is None or args.det_base is None:
+        return path
+    from pftrack.io.mot import MotFile
+
+    return MotFile(path, args.det_base)
 
 
-def _det_scale(args: argparse.Namespace, source: Any, det_path: str, said: list[str]) -> float:
+def _det_scale(
+    args: argparse.Namespace, source: Any, det_path: str | os.PathLike[str], said: list[str]
+) -> float:
     """``--det-scale``, or the sequence's own: its detections are in seqinfo.ini's pixels.
 
     A scale taken from seqinfo.ini is said in `said` (printed once the outputs are written).

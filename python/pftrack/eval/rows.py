@@ -280,6 +280,74 @@ def result_class_note(result: ArrayLike, benchmark: str) -> str | None:
     return f"{boxes} {which} in column 8: scored as pedestrians{refused}"
 
 
+#: MOT16/17/20's ground-truth classes (column 8), as their papers and TrackEval name them.
+CLASS_NAMES = {
+    1: "pedestrian", 2: "person on vehicle", 3: "car", 4: "bicycle", 5: "motorbike",
+    6: "non-motorized vehicle", 7: "static person", 8: "distractor", 9: "occluder",
+    10: "occluder on the ground", 11: "occluder full", 12: "reflection", 13: "crowd",
+}  # fmt: skip
+
+
+def gt_rules_note(
+    gt: ArrayLike, result: ArrayLike, benchmark: str, *, scale: float = 1.0
+) -> str | None:
+    """What `benchmark`'s rules leave out of `gt` and `result`, or None when they score it all.
+
+    :func:`prepare_mot`'s rules were said only as "MOT17 ground-truth rules" below the table:
+    a truth of 5 people, one a static person, one a distractor, one flagged 0, scored GT 2, and
+    a result equal to the truth scored 55 false positives (its boxes on the flagged person, as
+    TrackEval counts them), without a word of either. The note counts the ground-truth rows
+    not scored, by class (MOT16/17/20) and by the consider flag (column 7), the result boxes
+    left out (matched to a distractor), says that boxes on the other rows not scored count
+    as false positives, and that visibility (column 9) is not thresholded (MOT16/17/20: MOT15's
+    columns 8-10 are world coordinates). None when every ground-truth row is scored.
+
+    Parameters
+    ----------
+    gt, result : (M, 6..10) array_like of float
+        MOT rows, as :func:`prepare_mot` takes them.
+    benchmark : {"MOT15", "MOT16", "MOT17", "MOT20"}
+        The rules they were scored by.
+    scale : float
+        The ground truth's scale (:func:`prepare_mot`'s).
+    """
+    g = check_eval_rows(gt, "ground truth")
+    flagged = np.trunc(g[:, CONF]) == 0
+    with_classes = benchmark != "MOT15"
+    other = g[:, _CLASS] != _PEDESTRIAN if with_classes else np.zeros(len(g), dtype=bool)
+    left = int(np.sum(flagged | other))
+    if not left:
+        return None
+    parts = []
+    if other.any():
+        values, counts = np.unique(g[other, _CLASS].astype(np.int64), return_counts=True)
+        order = np.argsort(-counts, kind="stable")
+        parts = [
+            f"{counts[k]} of class {values[k]} ({CLASS_NAMES.get(int(values[k]), 'unknown')})"
+            for k in order
+        ]
+    flagged_scored = int(np.sum(flagged & ~other))
+    if flagged_scored:
+        kind = "pedestrians" if with_classes else "rows"
+        parts.append(f"{flagged_scored} {kind} flagged 0 (column 7)")
+    kept = "pedestrians, class 1, flagged 1" if with_classes else "flagged 1 in column 7"
+    said = (
+        f"{benchmark} rules, as TrackEval: {len(g) - left} of its {len(g)} rows scored "
+        f"({kept}); not scored: {', '.join(parts)}"
+    )
+    if with_classes:
+        r = check_eval_rows(result, "result")
+        dropped = len(r) - len(prepare_mot(g, r, benchmark=benchmark, scale=scale)[1])
+        distractors = _DISTRACTORS + ((_NON_MOT_VEHICLE,) if benchmark == "MOT20" else ())
+        said += (
+            f"; {dropped} result boxes matched to a distractor (classes "
+            f"{', '.join(map(str, distractors))}) left out, boxes on the other rows not "
+            "scored count as false positives"
+        )
+        return said + "; visibility (column 9) is not thresholded"
+    return said + "; result boxes on them count as false positives"  # MOT15: no visibility
+
+
 def gt_conf_note(gt: ArrayLike) -> str | None:
     """What is odd in the "consider" flag (column 7) of ground truth `gt`, or None.
 

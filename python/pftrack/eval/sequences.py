@@ -80,6 +80,9 @@ class SequenceInfo:
         ``seqLength`` from ``seqinfo.ini`` (None without one).
     width, height : int or None
         ``imWidth``, ``imHeight`` from ``seqinfo.ini``.
+    seqinfo : pathlib.Path or None
+        The ``seqinfo.ini`` they were read from (None without one): what a refusal by its
+        ``seqLength`` names (:func:`name_seqinfo`).
     """
 
     name: str
@@ -87,6 +90,20 @@ class SequenceInfo:
     length: int | None = None
     width: int | None = None
     height: int | None = None
+    seqinfo: Path | None = None
+
+
+def name_seqinfo(message: str, seqinfo: PathLike | None) -> str:
+    """A scorer's refusal of a frame past ``seqLength`` (:func:`prepare_mot`), naming its file.
+
+    ``... beyond the sequence's 71 frames (seqLength)`` said neither which ``seqinfo.ini``
+    nor that the mend may be there (a seqLength cut short, another sequence's file) or in the
+    rows (a result of a longer video): now ``(seqLength in SEQ/seqinfo.ini)``. Any other
+    message, or no file, is returned as it is.
+    """
+    if seqinfo is None or "(seqLength)" not in message:
+        return message
+    return message.replace("(seqLength)", f"(seqLength in {seqinfo})")
 
 
 def read_seqinfo(path: PathLike) -> dict[str, str]:
@@ -124,7 +141,9 @@ def _sequence(folder: Path, only: Collection[str] | None = None) -> SequenceInfo
     # its errors name the file, key and value, as theirs do; only the keys scoring uses are
     # read (an invalid frameRate, which no score uses, does not refuse the sequence)
     info = read_info(ini, keys=("seqLength", "imWidth", "imHeight"))
-    return SequenceInfo(folder.name, gt, length=info.length, width=info.width, height=info.height)
+    return SequenceInfo(
+        folder.name, gt, length=info.length, width=info.width, height=info.height, seqinfo=ini
+    )
 
 
 def sequence_of_file(gt_file: PathLike, name: str) -> SequenceInfo:

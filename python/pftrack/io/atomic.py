@@ -41,6 +41,7 @@ import stat
 import sys
 import tempfile
 import threading
+import time
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -1185,6 +1186,9 @@ _LOOKED_LOCK = threading.Lock()
 def _say_left_backups(folder: Path) -> None:
     """Warn, one line each, of the backups (``.NAME.<hex>.old``) a killed run left in `folder`.
 
+    And of its temporary files (:data:`_TEMP_NAME`) unwritten for :data:`STALE_SECONDS` or
+    more (:func:`_left_temporary`), which only such a run leaves.
+
     Only a ``kill -9`` (or a power cut) during :func:`staged_outputs`' renames leaves one; it
     may hold a target's earlier contents, and without hard links it is their only copy (the
     target itself was moved there). Nothing reads or removes it: the user is told, once per
@@ -1201,10 +1205,46 @@ def _say_left_backups(folder: Path) -> None:
             names = sorted(e.name for e in entries if e.is_file(follow_symlinks=False))
     except OSError:
         return  # not readable: the write says what is wrong, if anything
+    now = time.time()
     for name in names:
         found = _BACKUP_NAME.fullmatch(name)
         if found is not None:
             warn_outside(_left_backup(folder / name, folder / found.group(1)))
+        elif _TEMP_NAME.fullmatch(name) and not name.endswith(_KEPT_SUFFIXES):
+            with contextlib.suppress(OSError):  # gone meanwhile: its run finished
+                age = now - os.lstat(folder / name).st_mtime
+                if age >= STALE_SECONDS:
+                    warn_outside(_left_temporary(folder / name, age))
+
+
+#: How long a temporary file (:data:`_TEMP_NAME`) must have gone unwritten before
+#: :func:`_say_left_backups` calls it left: a run writing its video writes it every frame, and
+#: its other temporaries exist only while they are written, at its end.
+STALE_SECONDS = 600.0
+#: The hidden names pftrack's writers give their temporary files: ``.NAME.<hex>SUFFIX``
+#: (:func:`atomic_write`, :func:`atomic_path`, :func:`staged_outputs`), ``..NAME.<hex>.<hex>
+#: SUFFIX`` (a video written into a staged file), ``.NAME.<hex>.probe`` (the output check's).
+_TEMP_NAME = re.compile(r"\.\.?.+\.[0-9a-f]{12}(\.[0-9a-f]{12})?(\.[^.]+)?", re.DOTALL)
+#: Suffixes of hidden files said otherwise: backups (above), and a live run's online rows
+#: kept on purpose after a second Ctrl-C (``.part``, :func:`side_file`; the run says where).
+_KEPT_SUFFIXES = (BACKUP_SUFFIX, ".part")
+
+
+def _left_temporary(path: Path, age: float) -> str:
+    """The one line :func:`_say_left_backups` gives for a temporary file left `age` s ago.
+
+    Ctrl-C and SIGTERM remove a run's temporary files; ``kill -9``, the out-of-memory killer
+    or a power cut cannot, and each left one stayed unsaid beside the outputs, never read nor
+    removed (a trial at stop 74: ``.r.<hex>.mp4`` and ``..r.<hex>.<hex>.mp4``, 6 MB, for a
+    ``track --render`` killed 4 s in; a later run left them as they were).
+    """
+    hours = age / 3600
+    when = f"{hours:.0f} h" if hours >= 1 else f"{age / 60:.0f} min"
+    return (
+        f"{path} is a partial file of a pftrack run that stopped writing it {when} ago (killed: "
+        "kill -9, out of memory, a power cut) and left it; nothing reads it: delete it, unless "
+        "a run that is still going (paused?) writes there"
+    )
 
 
 def _left_backup(backup: Path, target: Path) -> str:

@@ -12,6 +12,7 @@ file such as ``np.savetxt``'s, written in their shortest round-trip form; :func:
 from __future__ import annotations
 
 import itertools
+import os
 import re
 from collections.abc import Iterable, Iterator
 from pathlib import Path
@@ -173,8 +174,89 @@ def data_line(path: PathLike, k: int) -> tuple[int, str]:
     return next(itertools.islice(_data_lines(Path(path)), k, None))
 
 
+#: The frame numberings a MOT file may be read in (:class:`MotFile`, ``--det-base``): 1 is
+#: MOTChallenge's (det.txt, gt.txt, every tracker's export read here), 0 a decoder's index,
+#: KITTI's, Python's ``enumerate``.
+FRAME_BASES = (0, 1)
+
+
+class MotFile(os.PathLike[str]):
+    """A MOT file's path together with the number its frames count from.
+
+    What ``--det-base 0`` hands to the readers: :func:`read_mot`, and through it
+    :func:`pftrack.load_detections`, :func:`pftrack.tracking.run.track_path` and ``pftrack
+    batch``'s tasks, read the file's frame ``k`` as frame ``k - first_frame + 1``, the
+    MOTChallenge numbering every other part of pftrack uses. A plain path reads from 1. The
+    numbering travels with the path (not a setting of the reader) so that every function
+    handed it reads it alike, and a note that guesses the numbering (:func:`zero_based_note`)
+    says nothing of a file whose numbering was stated.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    first_frame : {0, 1}
+        The number of the video's first frame in the file.
+
+    Examples
+    --------
+    >>> dets = pftrack.load_detections(MotFile("det0.txt", first_frame=0))  # doctest: +SKIP
+    """
+
+    def __init__(self, path: PathLike, first_frame: int = 1) -> None:
+        self.path = os.fspath(path_arg(path, "MotFile: path"))
+        self.first_frame = frame_base(first_frame, "MotFile: first_frame")
+
+    def __fspath__(self) -> str:
+        """The file's path."""
+        return self.path
+
+    def __str__(self) -> str:
+        """The path, as messages name the file."""
+        return self.path
+
+    def __repr__(self) -> str:
+        """``MotFile('det0.txt', first_frame=0)``."""
+        return f"MotFile({self.path!r}, first_frame={self.first_frame})"
+
+    def __eq__(self, other: object) -> bool:
+        """Equal paths read from the same frame."""
+        if not isinstance(other, MotFile):
+            return NotImplemented
+        return (self.path, self.first_frame) == (other.path, other.first_frame)
+
+    def __hash__(self) -> int:
+        """As the pair it compares."""
+        return hash((self.path, self.first_frame))
+
+    def __reduce__(self) -> tuple[type[MotFile], tuple[str, int]]:
+        """Pickled as its two fields (a batch task's detections go to Dask's workers)."""
+        return (MotFile, (self.path, self.first_frame))
+
+
+def frame_base(value: object, what: str) -> int:
+    """`value` as one of :data:`FRAME_BASES`, or a one-line TypeError / ValueError naming `what`."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{what} must be 0 or 1, got {shown(value)}")
+    if int(value) not in FRAME_BASES:
+        raise ValueError(
+            f"{what} is {int(value)}, expected 0 (frames numbered from 0) or 1 (MOTChallenge's "
+            "numbering, from 1)"
+        )
+    return int(value)
+
+
+def stated_base(path: object) -> int | None:
+    """The first frame `path` states (a :class:`MotFile`), or None for a plain path."""
+    return path.first_frame if isinstance(path, MotFile) else None
+
+
 def read_mot(
-    path: PathLike, *, what: str = "MOT file", warn_extra: bool = False
+    path: PathLike,
+    *,
+    what: str = "MOT file",
+    warn_extra: bool = False,
+    first_frame: int | None = None,
 ) -> NDArray[np.float64]:
     """Read a MOTChallenge file into an ``(M, 10)`` float64 array.
 
@@ -186,11 +268,14 @@ def read_mot(
         How errors name the file ("detection file", "ground truth", ...).
     warn_extra : bool
         Warn when lines have more than 10 columns (they are read, the rest dropped).
+    first_frame : {0, 1}, optional
+        The number the file's frames count from; rows are returned numbered from 1 (a file
+        numbered from 0 gets 1 added to every frame). None: the :class:`MotFile`'s, else 1.
 
     Returns
     -------
     (M, 10) ndarray of float64
-        Rows in file order. An empty file gives shape ``(0, 10)``.
+        Rows in file order, frames from 1. An empty file gives shape ``(0, 10)``.
 
     Raises
     ------
@@ -220,6 +305,11 @@ def read_mot(
         With `warn_extra`, once, naming the file and its most columns on a line, when that is
         more than 10: columns 11 and beyond are not kept.
     """
+    base = (
+        stated_base(path)
+        if first_frame is None
+        else frame_base(first_frame, "read_mot: first_frame")
+    )
     p = Path(path_arg(path, "read_mot: path"))
     _check.text(what, "read_mot: what", none=False)  # it names the file in every message below
     if not p.is_file():
@@ -231,7 +321,7 @@ def read_mot(
         refuse_loop(p, what)
         raise FileNotFoundError(f"{what} not found: {p}")
     try:
-        return _read_rows(p, what, warn_extra)
+        return _read_rows(p, what, warn_extra, 1 if base is None else base)
     except OSError as exc:
         if exc.filename is not None:  # open()'s errors name the file already
             raise
@@ -240,10 +330,10 @@ def read_mot(
         raise OSError(exc.errno, exc.strerror or str(exc), str(p)) from None
 
 
-def _read_rows(p: Path, what: str, warn_extra: bool) -> NDArray[np.float64]:
-    """:func:`read_mot` of the regular file `p`, once its path is checked."""
+def _read_rows(p: Path, what: str, warn_extra: bool, base: int = 1) -> NDArray[np.float64]:
+    """:func:`read_mot` of the regular file `p`, once its path is checked; frames from `base`."""
     _refuse_binary(p, what)
-    fast = _read_fast(p)
+    fast = _read_fast(p, 1 - base)
     if fast is not None:
         return fast
     rows: list[list[float]] = []
@@ -253,7 +343,7 @@ def _read_rows(p: Path, what: str, warn_extra: bool) -> NDArray[np.float64]:
     for lineno, text in _data_lines(p):
         if warn_extra:
             most = max(most, len(_fields(text)))
-        values = _parse_line(text, what)
+        values = _parse_line(text, what, 1 - base)
         if isinstance(values, str):
             error = f"{p}:{lineno}: {values}"
             if not rows and _WORD.search(text) and _split(text)[0].strip() == "":
@@ -336,6 +426,12 @@ INDEX_HINT = (
     "pandas' to_csv writes one by default: write the file with to_csv(path, header=False, "
     "index=False)"
 )
+#: What a refused frame 0 of a detection file adds inside the hint's brackets: the option that
+#: reads it as it is (was: only the awk that rewrites it, stop 73).
+DET_BASE_HINT = (
+    "; or read it as numbered from 0: --det-base 0 (pftrack track, batch), "
+    "MotFile(path, first_frame=0) in Python"
+)
 #: A word: two letters in a row, which no number has (``1e5``, ``inf`` is refused as such).
 _WORD = re.compile(r"[A-Za-z_]{2,}")
 
@@ -379,10 +475,11 @@ _NUMBER = re.compile(
 )
 
 
-def _parse_line(text: str, what: str) -> list[float] | str:
+def _parse_line(text: str, what: str, shift: int = 0) -> list[float] | str:
     """The 10 values of a line of a MOTChallenge file, or what is wrong with it (boxes aside).
 
-    Missing columns get their defaults. The boxes are :func:`read_mot`'s to check.
+    Missing columns get their defaults. The boxes are :func:`read_mot`'s to check. `shift`
+    is added to the frame (1 for a file numbered from 0: :class:`MotFile`).
     """
     fields = _fields(text)
     # an empty field is refused, never skipped (the values after it would shift into its
@@ -415,9 +512,17 @@ def _parse_line(text: str, what: str) -> list[float] | str:
             f"{what} line has a non-finite value ({kind}) in column {c + 1} ({_NAMES[c]}): "
             f"{text[:80]!r}"
         )
-    frame = values[FRAME]
+    frame = values[FRAME] + shift
+    values[FRAME] = frame
+    if shift and (frame < 1 or frame != int(frame) or frame > MAX_FRAME):
+        return (
+            f"frame is {fields[0]}, expected an integer in 0..{MAX_FRAME - shift} (the file is "
+            "read as numbered from 0, --det-base 0)"
+        )
     if frame < 1 or frame != int(frame) or frame > MAX_FRAME:
         hint = frames_from_1(frame, "the first value of each line")
+        if frame == 0 and what == "detection file":
+            hint = hint[:-1] + DET_BASE_HINT + ")"
         if frame == 0 and len(fields) == 11 and _NUMBER.fullmatch(fields[1]):
             second = float(fields[1])
             if second >= 1 and second == int(second):  # row 0 of an index, then frame 1, ...
@@ -427,7 +532,7 @@ def _parse_line(text: str, what: str) -> list[float] | str:
     return values
 
 
-def _read_fast(p: Path) -> NDArray[np.float64] | None:
+def _read_fast(p: Path, shift: int = 0) -> NDArray[np.float64] | None:
     """The rows of a well-formed file in one vectorised parse, or None.
 
     None sends the file to the line-by-line reader, which names the first bad line. A UTF-8
@@ -447,6 +552,8 @@ def _read_fast(p: Path) -> NDArray[np.float64] | None:
     n = a.shape[1]
     if not 6 <= n <= 10:
         return None
+    if shift:  # a file numbered from 0 (MotFile): its frames from 1, as every reader's
+        a[:, FRAME] += shift
     fr = a[:, FRAME]
     finite = bool(np.all(np.isfinite(a)))  # every column: a NaN score too
     if not (finite and np.all(fr >= 1) and np.all(fr == np.floor(fr))) or np.any(fr > MAX_FRAME):
@@ -893,7 +1000,8 @@ def zero_based_note(
     range (:data:`DENSE_SHARE`, at least :data:`DENSE_FRAMES` frames): a detector that finds
     something on almost every frame and nothing on the last is rare; the same file numbered
     from 1 would reach the video's last frame. Nothing is said when the count is unknown
-    (`n_frames` 0: a camera, a stream) or the file reaches the last frame.
+    (`n_frames` 0: a camera, a stream) or the file reaches the last frame, nor of a file whose
+    numbering was stated (a :class:`MotFile`: ``--det-base``).
 
     Parameters
     ----------
@@ -909,16 +1017,25 @@ def zero_based_note(
     mended : str
         The name the mend's command writes.
     """
+    if stated_base(path) is not None:  # --det-base given, MotFile: the user's word stands
+        return None
     held = np.unique(np.fromiter(frames, dtype=np.int64))
     if n_frames < 2 or len(held) < DENSE_FRAMES or held[-1] != n_frames - 1:
         return None
     first, last = int(held[0]), int(held[-1])
     if len(held) < DENSE_SHARE * (last - first + 1):
         return None
+    detections = what == "detections"  # read by track and batch, which take --det-base
+    option = (
+        "read it with --det-base 0 (MotFile(path, first_frame=0) in Python) or "
+        if detections
+        else ""
+    )
+    stated = " (--det-base 1 says so, and silences this)" if detections else ""
     return (
         f"{path}: {what} on {len(held)} of frames {first}-{last}, and none on the video's "
         f"last frame, {n_frames}: numbered from 0 (KITTI, a decoder's index, enumerate)? "
         "pftrack reads MOTChallenge frames, which count from 1, and would draw every box on "
-        f"the frame before its own; if so, add 1 to every frame (awk -F, -v OFS=, "
-        f"'{{$1+=1}}1' {path} > {mended}); if the file counts from 1, nothing is wrong"
+        f"the frame before its own; if so, {option}add 1 to every frame (awk -F, -v OFS=, "
+        f"'{{$1+=1}}1' {path} > {mended}); if the file counts from 1, nothing is wrong{stated}"
     )
