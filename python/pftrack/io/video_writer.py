@@ -43,6 +43,10 @@ VIDEO_SUFFIXES = (".mp4", ".avi")
 MAX_H264_SIDE = 16384
 #: Largest x264 constant rate factor of 8-bit video (:class:`VideoWriter`'s `crf`, from 0).
 MAX_CRF = 51
+#: x264's frame threads of an ``.mp4`` (:class:`VideoWriter`): a fixed count, so that the file's
+#: bytes do not depend on the machine's cores; for frames of at least `_X264_THREADS_FROM` rows.
+_X264_THREADS = 2
+_X264_THREADS_FROM = 360
 #: x264's presets, fastest first (:class:`VideoWriter`'s `preset`).
 X264_PRESETS = (
     "ultrafast", "superfast", "veryfast", "faster", "fast", "medium", "slow", "slower",
@@ -227,10 +231,18 @@ class VideoWriter:
             stream = self._container.add_stream("libx264", rate=rate)
             stream.width, stream.height, stream.pix_fmt = w, h, "yuv420p"
             stream.options = {"crf": str(self.crf), "preset": self.preset}
-            # x264 on the calling thread: pftrack renders on a thread of its own beside the
-            # tracker's, and x264's own threads cost CPU there (795 PETS09 frames, conversion
-            # included: 1.45 s of CPU against 2.2 s with its default threads)
-            stream.thread_count = 1
+            # two x264 frame threads, fixed (never FFmpeg's count of the machine's cores): the
+            # encode leaves the calling thread, which draws the next frame meanwhile (the render
+            # worker was the crowd's critical path), for the CPU and the pictures of one thread
+            # (the 1280x720 crowd and PETS09: every frame decodes equal); x264's settings string
+            # says "threads=2", so the bytes are the same from run to run and machine to machine.
+            # Only from 360 rows: frame threads bound the vertical motion vectors to about a
+            # quarter of the height (x264's mv_range_thread), which binds on small frames (a
+            # 101x75 scene: 13 of 40 frames differ, 40.7 dB). Sliced threads change the
+            # pictures (37.9 dB median on the crowd) and FFmpeg's default count costs CPU
+            # (795 PETS09 frames: 2.2 s against 1.45 s on one thread): docs/results.md, rend74
+            stream.thread_count = _X264_THREADS if h >= _X264_THREADS_FROM else 1
+            stream.thread_type = "FRAME"
             self._stream = stream
             return
         candidates = ("MJPG",) if self.path.suffix.lower() == ".avi" else ("avc1", "mp4v")
