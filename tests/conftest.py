@@ -70,3 +70,35 @@ def _not_quiet() -> Iterator[None]:
     before = quiet()
     yield
     set_quiet(before)
+
+
+#: The device files tests write through (``--out /dev/stdout``, ``/dev/null``) or read.
+_DEVICES = ("/dev/stdout", "/dev/stderr", "/dev/stdin", "/dev/null", "/dev/fd")
+
+
+def _device_files() -> dict[str, tuple[int, int] | None]:
+    """Each of :data:`_DEVICES`' type and inode, not followed (None where there is none)."""
+    found: dict[str, tuple[int, int] | None] = {}
+    for name in _DEVICES:
+        try:
+            st = os.lstat(name)
+        except OSError:
+            found[name] = None
+        else:
+            found[name] = (st.st_mode, st.st_ino)
+    return found
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _devices_kept() -> Iterator[None]:
+    """No test may replace a device file it writes through (pftrack's outputs run as root).
+
+    Was: on stop 74's machine ``/dev/stdout`` turned out a regular file (put there by a command
+    outside the suite; the suite itself, run then, left the link as it was), and every write
+    through it replaced it again, so three tests of ``--out /dev/stdout`` failed for a reason
+    no message said. A replacement made by the tests fails here, at the session's end.
+    """
+    before = _device_files()
+    yield
+    changed = sorted(k for k, v in _device_files().items() if v != before[k])
+    assert not changed, f"replaced while the tests ran: {', '.join(changed)}"
