@@ -23,21 +23,10 @@ import pytest
 
 from pftrack.cli import main
 from pftrack.io.mot import FRAME_BASES, MotFile, read_mot, zero_based_note
-from pftrack.synthetic import make_scene
+from tests import test_trial73_zero_based as zero_based
 
-FRAMES = 40
-SAID = "numbered from 0 (KITTI, a decoder's index, enumerate)?"
-
-
-@pytest.fixture(scope="module")
-def scene(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, np.ndarray]:
-    """A 40-frame video and its truth's boxes as detections (frame, -1, box, 0.95), from 1."""
-    folder = tmp_path_factory.mktemp("scene")
-    s = make_scene(n_frames=FRAMES, rng=1)
-    video = s.write_video(folder / "video.avi")
-    dets = s.truth.copy()
-    dets[:, 1], dets[:, 6] = -1, 0.95
-    return video, dets
+# the scene and the note's words of trial73's tests (a video and its truth as detections)
+FRAMES, SAID, scene = zero_based.FRAMES, zero_based.SAID, zero_based.scene
 
 
 def det_file(path: Path, rows: np.ndarray) -> Path:
